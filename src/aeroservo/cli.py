@@ -1,0 +1,195 @@
+"""The ``aeroservo`` command.
+
+Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure.
+Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
+need them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from .errors import InputError
+
+__all__ = ["main"]
+
+
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not v > 0 or v != v or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number > 0")
+    return v
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be >= 1")
+    return v
+
+
+def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
+    p = argparse.ArgumentParser(
+        prog="aeroservo",
+        description="Aero-servo-elastic analysis of wings with control surfaces (SI units).",
+    )
+    p.add_argument("--version", action="version", version=f"aeroservo {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    f = sub.add_parser(
+        "flutter",
+        help="flutter and divergence boundaries of a wing",
+        description="Flutter and divergence boundaries of a built-in wing or a wing file.",
+    )
+    f.add_argument("wing", help="built-in wing (goland, goland_aileron) or path to a wing .toml")
+    f.add_argument("--json", action="store_true", help="print one JSON object")
+    f.add_argument(
+        "--density", type=_positive_float, help="air density [kg/m^3] (default: file, else 1.225)"
+    )
+    f.add_argument(
+        "--elements", type=_positive_int, help="number of beam elements (default: file, else 10)"
+    )
+    f.add_argument("--wagner", help="Wagner set: rt_jones, wp_jones, one_term, fit2, fit3, fit4")
+    f.add_argument("--v-max", type=_positive_float, help="upper end of the speed search [m/s]")
+    f.add_argument("--modes", type=_positive_int, help="number of tracked modes (default 8)")
+    f.add_argument(
+        "--pk", action="store_true", help="also solve by p-k with the exact Theodorsen function"
+    )
+    f.add_argument("--plot", metavar="FILE", help="write V-g and V-f diagrams (png, pdf, svg)")
+
+    m = sub.add_parser("modes", help="natural frequencies of a wing (in vacuo)")
+    m.add_argument("wing")
+    m.add_argument("--elements", type=_positive_int)
+    m.add_argument("-n", type=_positive_int, default=6, help="number of modes (default 6)")
+    m.add_argument("--json", action="store_true")
+
+    sub.add_parser("examples", help="list the built-in wings")
+    return p
+
+
+def _cmd_flutter(args: argparse.Namespace) -> int:
+    from .aeroelastic import AeroelasticModel
+    from .stability import flutter_boundary
+    from .wingfile import resolve_wing
+
+    wing, opts = resolve_wing(args.wing)
+    density = args.density if args.density is not None else opts.density
+    elements = args.elements if args.elements is not None else opts.elements
+    wagner = args.wagner if args.wagner is not None else opts.wagner
+    v_max = args.v_max if args.v_max is not None else opts.v_max
+    n_modes = args.modes if args.modes is not None else opts.n_modes
+    model = AeroelasticModel(wing, n_elements=elements, wagner=wagner)
+    result = flutter_boundary(model, density, v_max=v_max, n_modes=n_modes)
+    out = {
+        "wing": wing.name,
+        "flutter_speed": result.flutter_speed,
+        "flutter_frequency": result.flutter_frequency,
+        "divergence_speed": result.divergence_speed,
+        "n_states": result.n_states,
+        "density": density,
+        "n_elements": model.n_elements,
+        "wagner": model.wagner.name,
+        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3"},
+    }
+    out.update({k: v for k, v in result.to_dict().items() if k not in out})
+    if args.pk:
+        from .pk import pk_flutter
+
+        pk = pk_flutter(model, density, v_max=result.v_max, n_modes=n_modes)
+        out["pk_exact_theodorsen"] = {
+            "flutter_speed": pk.flutter_speed,
+            "flutter_frequency": pk.flutter_frequency,
+            "divergence_speed": pk.divergence_speed,
+        }
+    if args.plot:
+        from .fileio import save_figure
+        from .plots import plot_vg
+
+        fig = plot_vg(
+            result, title=f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
+        )
+        save_figure(fig, args.plot, dpi=150)
+        out["plot"] = args.plot
+    if args.json:
+        print(json.dumps(out, indent=2))
+    else:
+        print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
+        print(result.summary())
+        if args.pk:
+            pkr = out["pk_exact_theodorsen"]
+            if pkr["flutter_speed"] is None:
+                print("p-k (exact Theodorsen): no flutter in the searched range")
+            else:
+                print(
+                    f"p-k (exact Theodorsen): flutter {pkr['flutter_speed']:.6g} m/s at "
+                    f"{pkr['flutter_frequency']:.5g} Hz"
+                )
+        if args.plot:
+            print(f"plot written to {args.plot}")
+    return 0
+
+
+def _cmd_modes(args: argparse.Namespace) -> int:
+    from .aeroelastic import AeroelasticModel
+    from .wingfile import resolve_wing
+
+    wing, opts = resolve_wing(args.wing)
+    model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
+    modes = model.natural_modes(min(args.n, model.n_dofs))
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "wing": wing.name,
+                    "frequencies": modes.frequencies.tolist(),
+                    "labels": modes.labels,
+                    "units": {"frequency": "Hz"},
+                },
+                indent=2,
+            )
+        )
+    else:
+        print(f"{wing.name}: {model.n_elements} elements, in-vacuo natural modes")
+        for f, lab in zip(modes.frequencies, modes.labels, strict=True):
+            print(f"  {f:10.4f} Hz  {lab}")
+    return 0
+
+
+def _cmd_examples(args: argparse.Namespace) -> int:
+    from .examples import BUILTIN_WINGS
+
+    print("built-in wings:")
+    for name, fn in BUILTIN_WINGS.items():
+        doc = (fn.__doc__ or "").strip().splitlines()[0]
+        print(f"  {name:16s} {doc}")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    handlers = {"flutter": _cmd_flutter, "modes": _cmd_modes, "examples": _cmd_examples}
+    try:
+        return handlers[args.command](args)
+    except InputError as exc:
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ArithmeticError, __import__("numpy").linalg.LinAlgError) as exc:
+        print(f"aeroservo: numerical failure: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
