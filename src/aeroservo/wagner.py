@@ -86,12 +86,10 @@ class IndicialSet:
 
     def transfer(self, k: np.ndarray | float) -> np.ndarray:
         """Frequency-domain counterpart at reduced frequency ``k`` (approximates C(k))."""
-        ik = 1j * np.asarray(k, dtype=float)
+        ik = 1j * np.asarray(k, dtype=float)[..., None]
         A = np.asarray(self.A)
         b = np.asarray(self.b)
-        return 1.0 - np.sum(
-            A * np.multiply.outer(ik, 1.0) / (np.multiply.outer(ik, 1.0) + b), axis=-1
-        )
+        return 1.0 - np.sum(A * ik / (ik + b), axis=-1)
 
 
 WAGNER_SETS: dict[str, IndicialSet] = {
@@ -111,7 +109,7 @@ WAGNER_SETS: dict[str, IndicialSet] = {
         ),
         IndicialSet(
             (0.5,),
-            (0.1441348,),
+            (0.14418707,),
             "one_term",
             "least-squares fit to the exact Wagner function, A fixed at 1/2, "
             "aeroservo.wagner.fit_wagner(1); max |error| 0.045",

@@ -1,0 +1,36 @@
+# aeroservo: the two set-up commands are `make demo` and `make test` (README).
+# Each creates its own virtual environment in .venv (override with VENV=...).
+
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: install demo test lint bench clean
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	touch $(STAMP)
+
+demo: install
+	mkdir -p out
+	$(BIN)/aeroservo flutter goland --pk --plot out/goland_vg.png
+	$(BIN)/aeroservo flutter scenarios/goland_aileron.toml --json > out/goland_aileron_flutter.json
+	@echo "wrote out/goland_vg.png and out/goland_aileron_flutter.json"
+
+lint: install
+	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff format --check src tests bench
+
+test: lint
+	$(BIN)/python -m pytest
+
+bench: install
+	$(BIN)/python bench/bench_flutter.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache .ruff_cache

@@ -1,0 +1,83 @@
+"""Flutter-boundary benchmarks; every figure is a ratio to a baseline measured in the same run.
+
+1. In-process Goland flutter boundary, 10 elements, versus one dense ``scipy.linalg.eig`` of the
+   same state matrix (target: <= 40 such eig times).
+2. The same for 100 elements (target: < 1 s), model assembly reported separately.
+3. Whole process ``aeroservo flutter goland --json`` versus ``python -c "import numpy,
+   scipy.linalg"`` (target: <= 3x).
+
+Run: ``make bench`` (or ``python bench/bench_flutter.py``). Medians of repeated runs.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import time
+
+import scipy.linalg as sla
+
+import aeroservo as aes
+
+
+def median_time(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def in_process(n_elements: int, repeats: int) -> dict:
+    t0 = time.perf_counter()
+    model = aes.AeroelasticModel(aes.examples.goland(), n_elements)
+    build = time.perf_counter() - t0
+    aes.flutter_boundary(model, 1.225)  # warm-up (imports, caches)
+    t_fb = median_time(lambda: aes.flutter_boundary(model, 1.225), repeats)
+    a = model.state_matrix(137.0, 1.225)
+    t_eig = median_time(lambda: sla.eig(a), max(3, repeats))
+    return {
+        "elements": n_elements,
+        "n_states": model.n_states,
+        "build_s": build,
+        "boundary_s": t_fb,
+        "eig_s": t_eig,
+    }
+
+
+def whole_process(repeats: int) -> dict:
+    cli = [sys.executable, "-m", "aeroservo", "flutter", "goland", "--json"]
+    base = [sys.executable, "-c", "import numpy, scipy.linalg"]
+
+    def run(cmd):
+        subprocess.run(cmd, check=True, capture_output=True)
+
+    run(cli)
+    return {
+        "cli_s": median_time(lambda: run(cli), repeats),
+        "import_s": median_time(lambda: run(base), repeats),
+    }
+
+
+def main() -> None:
+    print("aeroservo flutter benchmarks (medians; ratios to baselines of the same run)")
+    for n, reps in ((10, 15), (100, 3)):
+        r = in_process(n, reps)
+        ratio = r["boundary_s"] / r["eig_s"]
+        print(
+            f"  Goland {n:3d} elements ({r['n_states']} states): "
+            f"boundary {r['boundary_s'] * 1e3:8.1f} ms = {ratio:6.1f} x one dense eig "
+            f"({r['eig_s'] * 1e3:.2f} ms); assembly {r['build_s'] * 1e3:.1f} ms"
+        )
+    w = whole_process(5)
+    ratio = w["cli_s"] / w["import_s"]
+    print(
+        f"  whole process 'aeroservo flutter goland --json': {w['cli_s']:.3f} s = {ratio:.2f} x "
+        f"'import numpy, scipy.linalg' ({w['import_s']:.3f} s)"
+    )
+
+
+if __name__ == "__main__":
+    main()

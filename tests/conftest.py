@@ -1,0 +1,47 @@
+"""Shared fixtures.
+
+Reference numbers come from ``tests/data/reference_cases.json``, a verbatim copy of the
+project's public reference data (``shared/reference/cases.json``, see its README for sources
+and confidence codes). Each test names the case id it uses.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+import aeroservo as aes
+
+DATA = Path(__file__).parent / "data"
+ROOT = Path(__file__).parent.parent
+
+
+def reference(case_id: str) -> dict:
+    """The reference case with this id."""
+    cases = json.loads((DATA / "reference_cases.json").read_text())["cases"]
+    for case in cases:
+        if case["id"] == case_id:
+            return case
+    raise KeyError(case_id)
+
+
+@pytest.fixture(scope="session")
+def goland10() -> aes.AeroelasticModel:
+    return aes.AeroelasticModel(aes.examples.goland(), n_elements=10)
+
+
+@pytest.fixture(scope="session")
+def goland40() -> aes.AeroelasticModel:
+    return aes.AeroelasticModel(aes.examples.goland(), n_elements=40)
+
+
+@pytest.fixture(scope="session")
+def goland10_flutter(goland10) -> aes.FlutterResult:
+    return aes.flutter_boundary(goland10, 1.225)
+
+
+@pytest.fixture(scope="session")
+def aileron10() -> aes.AeroelasticModel:
+    return aes.AeroelasticModel(aes.examples.goland_aileron(), n_elements=10)

@@ -1,0 +1,101 @@
+"""The command line: JSON contract, overrides, plots, exit codes."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+from conftest import ROOT
+
+import aeroservo as aes
+from aeroservo.cli import main
+
+
+def run_json(capsys, *argv):
+    assert main([*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_flutter_json_matches_python_api(capsys, goland10_flutter):
+    out = run_json(capsys, "flutter", "goland")
+    for key in (
+        "flutter_speed",
+        "flutter_frequency",
+        "divergence_speed",
+        "n_states",
+        "density",
+        "n_elements",
+    ):
+        assert key in out
+    assert out["flutter_speed"] == pytest.approx(goland10_flutter.flutter_speed, rel=1e-9)
+    assert out["flutter_frequency"] == pytest.approx(goland10_flutter.flutter_frequency, rel=1e-9)
+    assert out["n_states"] == 82 and out["n_elements"] == 10 and out["density"] == 1.225
+
+
+def test_flutter_wing_file_and_overrides(capsys):
+    path = str(ROOT / "scenarios" / "goland.toml")
+    base = run_json(capsys, "flutter", path)
+    out = run_json(
+        capsys, "flutter", path, "--density", "1.02", "--elements", "12", "--wagner", "fit4"
+    )
+    assert out["density"] == 1.02 and out["n_elements"] == 12 and out["wagner"] == "fit4"
+    assert out["n_states"] == 2 * 36 + 4 * 13
+    assert out["flutter_speed"] > base["flutter_speed"]  # thinner air flutters later
+
+
+def test_pk_option(capsys):
+    out = run_json(capsys, "flutter", "goland", "--pk")
+    assert out["pk_exact_theodorsen"]["flutter_speed"] == pytest.approx(137.46, rel=1e-3)
+
+
+def test_plot_written_atomically(tmp_path, capsys):
+    png = tmp_path / "vg.png"
+    assert main(["flutter", "goland", "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["vg.png"]  # no temporary left behind
+    assert "flutter:" in capsys.readouterr().out
+
+
+def test_plot_into_missing_folder_fails_cleanly(tmp_path, capsys):
+    assert main(["flutter", "goland", "--plot", str(tmp_path / "no" / "vg.png")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "argv,msg",
+    [
+        (["flutter", "cessna"], "not a built-in wing"),
+        (["flutter", "goland", "--wagner", "foo"], "unknown set"),
+        (["flutter", "missing.toml"], "no such file"),
+    ],
+)
+def test_input_errors_exit_2(argv, msg, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert msg in err and err.count("\n") == 1
+
+
+def test_usage_errors_exit_2():
+    with pytest.raises(SystemExit) as exc:
+        main(["flutter", "goland", "--density", "-1"])
+    assert exc.value.code == 2
+
+
+def test_modes_and_examples(capsys):
+    out = run_json(capsys, "modes", "goland", "-n", "3")
+    assert out["labels"][:2] == ["1st bending", "1st torsion"]
+    assert main(["examples"]) == 0
+    assert "goland_aileron" in capsys.readouterr().out
+
+
+def test_console_script_runs():
+    """The installed entry point, as a user types it (python -m for the same code path)."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "aeroservo", "flutter", "goland_aileron", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    out = json.loads(proc.stdout)
+    assert out["wing"] == aes.examples.goland_aileron().name
+    assert 130 < out["flutter_speed"] < 145
