@@ -31,6 +31,7 @@ test: lint
 
 bench: install
 	$(BIN)/python bench/bench_flutter.py
+	$(BIN)/python bench/bench_statespace.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .ruff_cache

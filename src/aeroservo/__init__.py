@@ -4,7 +4,9 @@ from . import examples
 from .aeroelastic import AeroelasticModel, NaturalModes
 from .errors import InputError
 from .model import Actuator, ControlSurface, Segment, Wing
+from .signals import Sensor
 from .stability import FlutterResult, divergence_speed, eigen_sweep, flutter_boundary
+from .statespace import Servo, StateSpaceBuilder, statespace, statespace_family
 from .wagner import KUSSNER_SETS, WAGNER_SETS, IndicialSet
 
 __version__ = "0.1.0"
@@ -19,10 +21,15 @@ __all__ = [
     "KUSSNER_SETS",
     "NaturalModes",
     "Segment",
+    "Sensor",
+    "Servo",
+    "StateSpaceBuilder",
     "WAGNER_SETS",
     "Wing",
     "divergence_speed",
     "eigen_sweep",
     "examples",
     "flutter_boundary",
+    "statespace",
+    "statespace_family",
 ]

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 from .beam_element import field_shapes, gauss_rule, integrate, lag_shapes, point_shapes
 from .mesh import Mesh
 from .model import Wing
-from .system import AeroMatrices
+from .system import AeroMatrices, StripGroup
 from .theodorsen import section_aero
 
 __all__ = ["assemble", "element_properties"]
@@ -102,19 +102,33 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     def elem(left, coef, right):
         return integrate(L, wts, left, coef[:, None], right)
 
+    # unknowns in an extended numbering: the clamped root (w, theta, phi) get the last 3 indices,
+    # so one scatter gives both the free matrices and the root-reaction rows
     n_q = mesh.n_dofs
-    edofs = mesh.element_dofs
-    sq = (n_q, n_q)
+    edofs = mesh.element_dofs.copy()
+    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
+    n_x = n_q + 3
+    n_n = mesh.n_nodes
+    lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
 
-    def glob(coef):
-        return _scatter(elem(N, coef, N), edofs, edofs, sq)
+    def split(blocks, rows, cols, shape):
+        """Scatter, then split extended structural rows/columns into free and root parts."""
+        full = _scatter(blocks, rows, cols, shape)
+        if cols is edofs:
+            full = full[:, :n_q]
+        if rows is edofs:
+            return full[:n_q], full[n_q:]
+        return full, None
 
-    Ms = glob(ms)
-    parts = {}
+    def qq(coef, left=N, right=N):
+        return split(elem(left, coef, right), edofs, edofs, (n_x, n_x))
+
+    Ms, Ms_r = qq(ms)
+    parts, parts_r = {}, {}
     for i, name in enumerate(("bending", "torsion")):
-        parts[name] = _scatter(elem(D, kd * _unit(i), D), edofs, edofs, sq)
+        parts[name], parts_r[name] = qq(kd * _unit(i), D, D)
     k_act = _actuator_stiffness(wing, mesh, n_q)
-    flap_all = _scatter(elem(D, kd * _unit(2), D) + elem(N, kn, N), edofs, edofs, sq) + k_act
+    flap_all = qq(kd * _unit(2), D, D)[0] + qq(kn)[0] + k_act
     for k, cs in enumerate(wing.control_surfaces):
         mask = np.zeros(n_q)
         d = mesh.dof_delta[k]
@@ -122,29 +136,52 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
         dm = sp.diags(mask)
         parts[f"flap ({cs.name})"] = (dm @ flap_all @ dm).tocsr()
     Ks = parts["bending"] + parts["torsion"] + flap_all
+    Ks_r = parts_r["bending"] + parts_r["torsion"]  # flap unknowns are never clamped
 
-    # circulatory matrices grouped by semichord, for the exact C(k) of the p-k method
-    groups = []
+    # circulatory matrices and load vectors grouped by semichord (exact C(k), gusts)
+    groups, groups_r = [], []
+    ones_z = np.ones((n_el, 1, 1))
     for b in np.unique(p["b"]):
         sel = (p["b"] == b).astype(float)[:, None, None]
-        groups.append((float(b), glob(aero.Pq * sel), glob(aero.Pd * sel)))
+        pq, pq_r = qq(aero.Pq * sel)
+        pd, pd_r = qq(aero.Pd * sel)
+        gw = _scatter(elem(N, aero.w[:, :, None] * sel, nz), edofs, lag_dofs, (n_x, n_n))
+        gw = np.asarray(gw.sum(axis=1)).ravel()  # lag shape functions sum to one
+        groups.append(StripGroup(float(b), pq, pd, gw[:n_q]))
+        groups_r.append(StripGroup(float(b), pq_r, pd_r, gw[n_q:]))
 
     # lag fields: term-independent base matrices on the nodes
-    n_n = mesh.n_nodes
-    lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
-    ones = np.ones((n_el, 1, 1))
-    Mz1 = _scatter(elem(nz, ones, nz), lag_dofs, lag_dofs, (n_n, n_n))
+    Mz1 = _scatter(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
     Lz1 = _scatter(elem(nz, (1.0 / p["b"])[:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n))
-    E1 = _scatter(elem(nz, aero.r_q[:, None, :], N), lag_dofs, edofs, (n_n, n_q))
-    F1 = _scatter(elem(nz, aero.r_d[:, None, :], N), lag_dofs, edofs, (n_n, n_q))
-    W1 = _scatter(elem(N, aero.w[:, :, None], nz), edofs, lag_dofs, (n_q, n_n))
+    E1 = split(elem(nz, aero.r_q[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    F1 = split(elem(nz, aero.r_d[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    W1, W1_r = split(elem(N, aero.w[:, :, None], nz), edofs, lag_dofs, (n_x, n_n))
+    Mnc, Mnc_r = qq(aero.Mnc)
+    Cnc, Cnc_r = qq(aero.Cnc)
+    Knc, Knc_r = qq(aero.Knc)
 
+    labels = tuple(str(i) for i in range(n_n))
+    root = AeroMatrices(
+        Ms=Ms_r,
+        Ks=Ks_r,
+        Mnc=Mnc_r,
+        Cnc=Cnc_r,
+        Knc=Knc_r,
+        circ_groups=tuple(groups_r),
+        Mz1=Mz1,
+        Lz1=Lz1,
+        E1=E1,
+        F1=F1,
+        W1=W1_r,
+        dof_labels=mesh.dof_labels,
+        lag_labels=labels,
+    )
     return AeroMatrices(
         Ms=Ms,
         Ks=Ks,
-        Mnc=glob(aero.Mnc),
-        Cnc=glob(aero.Cnc),
-        Knc=glob(aero.Knc),
+        Mnc=Mnc,
+        Cnc=Cnc,
+        Knc=Knc,
         circ_groups=tuple(groups),
         Mz1=Mz1,
         Lz1=Lz1,
@@ -152,8 +189,9 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
         F1=F1,
         W1=W1,
         dof_labels=mesh.dof_labels,
-        lag_labels=tuple(str(i) for i in range(n_n)),
+        lag_labels=labels,
         stiffness_parts=parts,
+        root=root,
     )
 
 

@@ -132,7 +132,7 @@ def _setup(am: AeroMatrices, rho: float) -> tuple[_PK, np.ndarray]:
         Ks=modal(am.Ks),
         Knc=modal(am.Knc),
         Cnc=modal(am.Cnc),
-        groups=[(b, modal(Pq), modal(Pd)) for b, Pq, Pd in am.circ_groups],
+        groups=[(g.b, modal(g.Pq), modal(g.Pd)) for g in am.circ_groups],
         rho=rho,
     )
     return pk, phi
@@ -188,7 +188,7 @@ def pk_flutter(
     p0 = 1j * np.sqrt(w2)
     v_div = static_divergence_speed(am, rho)
     if v_max is None:
-        b_ref = float(np.mean([g[0] for g in am.circ_groups]))
+        b_ref = float(np.mean([g.b for g in am.circ_groups]))
         v_max = 1.2 * v_div if v_div else 4.0 * b_ref * abs(p0[min(1, n_modes - 1)])
     v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
     speeds = np.linspace(0.0, v_max, n_speeds)

@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import InputError, check_number
-from .system import AeroMatrices, FirstOrderSystem, first_order
+from .system import AeroMatrices, FirstOrderSystem, StripGroup, first_order
 from .theodorsen import section_aero
 from .wagner import wagner_set
 
@@ -155,7 +155,11 @@ class TypicalSection:
             Mnc=csr(aero.Mnc[:n, :n]),
             Cnc=csr(aero.Cnc[:n, :n]),
             Knc=csr(aero.Knc[:n, :n]),
-            circ_groups=((self.semichord, csr(aero.Pq[:n, :n]), csr(aero.Pd[:n, :n])),),
+            circ_groups=(
+                StripGroup(
+                    self.semichord, csr(aero.Pq[:n, :n]), csr(aero.Pd[:n, :n]), aero.w[:n].copy()
+                ),
+            ),
             Mz1=csr(1.0),
             Lz1=csr(1.0 / self.semichord),
             E1=csr(aero.r_q[None, :n]),

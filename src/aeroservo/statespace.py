@@ -1,0 +1,603 @@
+"""Linear state-space export for control design (python-control ``StateSpace``, named signals).
+
+The model ``x' = A(V) x + B(V) u``, ``y = C(V) x + D(V) u`` is polynomial in the airspeed V:
+every coefficient matrix is computed once per (model, density, inputs, outputs) by
+:class:`StateSpaceBuilder`; a model at a speed, or a family over a speed grid, is then a few
+matrix additions.
+
+State vector (names in ``sys.state_labels``): structural unknowns q, their rates, the Wagner lag
+states ``z<i>_<node>``, the Kussner gust states ``g<i>_b<group>`` (gust model ``"kussner"``)
+and the servo states ``<surface>_servo[_rate]`` (commanded-deflection inputs with servo
+dynamics). Signals, units and sign conventions: :mod:`aeroservo.signals` and
+``docs/statespace.md``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .errors import InputError, check_number
+from .signals import (
+    Sensor,
+    actuator_rows,
+    hinge_moment_vector,
+    output_units,
+    resolve_inputs,
+    resolve_outputs,
+    sensor_row,
+    surface_mean_row,
+    surface_unit,
+)
+from .system import first_order
+from .wagner import IndicialSet, kussner_set
+
+__all__ = [
+    "Servo",
+    "StateSpaceBuilder",
+    "statespace",
+    "statespace_family",
+    "discretize",
+    "export_mat",
+    "export_npz",
+    "modal_controllability",
+]
+
+
+@dataclass(frozen=True)
+class Servo:
+    """Servo dynamics between a commanded deflection and the actuator springs.
+
+    Parameters
+    ----------
+    order : int
+        0 (ideal: the springs follow the command), 1 (first order, ``y' = w (u - y)``) or 2
+        (second order, ``y'' = w^2 (u - y) - 2 zeta w y'``).
+    bandwidth : float
+        w [rad/s] for order 1 and 2.
+    damping : float
+        zeta [-] for order 2.
+    """
+
+    order: int = 0
+    bandwidth: float = 0.0
+    damping: float = 0.7
+
+    def __post_init__(self) -> None:
+        if self.order not in (0, 1, 2):
+            raise InputError(f"servo.order = {self.order!r}: allowed values are 0, 1, 2")
+        if self.order > 0:
+            check_number("servo.bandwidth", self.bandwidth, unit="rad/s", lo=0.0, lo_open=True)
+        if self.order == 2:
+            check_number("servo.damping", self.damping, lo=0.0, lo_open=True)
+
+    @property
+    def n_states(self) -> int:
+        return self.order
+
+
+class _Poly:
+    """Matrix polynomial ``sum_k V^k c[k]``."""
+
+    __slots__ = ("c",)
+
+    def __init__(self, c: np.ndarray):
+        self.c = np.asarray(c, dtype=float)
+
+    @classmethod
+    def const(cls, m: np.ndarray) -> _Poly:
+        return cls(np.asarray(m, dtype=float)[None])
+
+    def __add__(self, other: _Poly) -> _Poly:
+        k = max(self.c.shape[0], other.c.shape[0])
+        out = np.zeros((k,) + self.c.shape[1:])
+        out[: self.c.shape[0]] += self.c
+        out[: other.c.shape[0]] += other.c
+        return _Poly(out)
+
+    def __matmul__(self, other: _Poly) -> _Poly:
+        k = self.c.shape[0] + other.c.shape[0] - 1
+        out = np.zeros((k, self.c.shape[1], other.c.shape[2]))
+        for i in range(self.c.shape[0]):
+            for j in range(other.c.shape[0]):
+                out[i + j] += self.c[i] @ other.c[j]
+        return _Poly(out)
+
+    def left(self, m: np.ndarray) -> _Poly:
+        """``m @ self`` for a constant matrix m."""
+        return _Poly(np.einsum("ij,kjl->kil", m, self.c))
+
+    def __call__(self, v: float) -> np.ndarray:
+        out = self.c[-1].copy()
+        for k in range(self.c.shape[0] - 2, -1, -1):
+            out *= v
+            out += self.c[k]
+        return out
+
+
+def _dense(m) -> np.ndarray:
+    return m.toarray() if sp.issparse(m) else np.asarray(m, dtype=float)
+
+
+class StateSpaceBuilder:
+    """Speed-independent state-space coefficients of a wing model; models at any speed are cheap.
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    density : float
+        Air density [kg/m^3].
+    inputs : sequence of str, optional
+        Input names (default: every surface's ``<s>_hinge_moment`` and ``gust``).
+    outputs : sequence of str or Sensor, optional
+        Output names or sensors (default ``tip_le_accel``, ``tip_te_accel``, ``tip_twist``).
+    servo : Servo or dict of Servo, optional
+        Servo dynamics of commanded-deflection inputs (per surface name, or one for all);
+        default ideal (order 0).
+    gust : {"kussner", "upwash"}
+        ``"kussner"``: the gust penetrates the chord; Kussner lag states (one set per distinct
+        semichord; uniform spanwise gust). ``"upwash"``: the chordwise travel time is neglected
+        and the gust acts as a uniform upwash through the Wagner lag states (no extra states).
+    kussner : str, mapping or IndicialSet
+        Kussner approximation (default Sears & Sparks).
+    n_modes : int, optional
+        Modal truncation of the structure: keep this many in-vacuo modes (the lag states stay
+        complete and consistent with the projected downwash). Default: no truncation.
+    """
+
+    def __init__(
+        self,
+        model,
+        density: float,
+        inputs: Sequence[str] | None = None,
+        outputs: Sequence[str | Sensor] | None = None,
+        *,
+        servo: Servo | dict | None = None,
+        gust: str = "kussner",
+        kussner: object = "sears_sparks",
+        n_modes: int | None = None,
+    ):
+        self.model = model
+        self.density = rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+        if gust not in ("kussner", "upwash"):
+            raise InputError(f"gust = {gust!r}: allowed values are 'kussner' and 'upwash'")
+        self.gust = gust
+        self.kussner: IndicialSet = kussner_set(kussner)
+        wing = model.wing
+        self.inputs = resolve_inputs(wing, inputs)
+        n_avail = model.n_dofs
+        self.outputs = resolve_outputs(model, outputs, n_avail)
+        self.servos = _servos(wing, servo, self.inputs)
+
+        # structural basis: full FE unknowns or a modal truncation
+        am = model.matrices
+        n_need = max([n_modes or 0] + [o.index + 1 for o in self.outputs if o.kind == "modal"])
+        modes = model.natural_modes(n_need) if n_need else None
+        if n_modes is not None:
+            n_modes = min(int(n_modes), n_avail)
+            am = am.project(modes.shapes[:, :n_modes])
+            basis = modes.shapes[:, :n_modes]
+        else:
+            basis = None
+        self.n_modes = n_modes
+
+        def vec(v: np.ndarray) -> np.ndarray:  # generalized force / row in the used unknowns
+            return v if basis is None else basis.T @ v
+
+        system = first_order(am, model.wagner, rho, model.semichord)
+        self.system = system
+        n_q = am.n_q
+        T = model.wagner.n_terms
+        n_z = T * am.n_nodes
+        groups = am.circ_groups
+        kus = self.kussner
+        has_gust = any(d.kind == "gust" for d in self.inputs)
+        n_g = len(groups) * kus.n_terms if (gust == "kussner" and has_gust) else 0
+        n_s = sum(sv.n_states for sv in self.servos.values())
+        n = 2 * n_q + n_z + n_g + n_s
+        m = len(self.inputs)
+        iq, iv = slice(0, n_q), slice(n_q, 2 * n_q)
+        iz = slice(2 * n_q, 2 * n_q + n_z)
+        ig = slice(iz.stop, iz.stop + n_g)
+        self.n_states = n
+
+        A = np.zeros((3, n, n))
+        B = np.zeros((2, n, m))
+        n0 = 2 * n_q + n_z
+        for k, a in enumerate((system.A0, system.A1, system.A2)):
+            A[k, :n0, :n0] = _dense(a)
+
+        # aerodynamic generalized forces (without apparent mass) on the free and root unknowns
+        wag = model.wagner
+        scale = 1.0 - sum(wag.A)
+        ab = np.asarray(wag.A) * np.asarray(wag.b)
+        rt = am.root
+        Fa = np.zeros((3, n_q, n))
+        Fa[:, :, :n0] = A[:, iv, :n0]
+        Fa[0, :, iq] += _dense(am.Ks)
+        Fr = np.zeros((3, 3, n))
+        Fr[2, :, iq] = -rho * _dense(rt.Knc - scale * rt.Pq)
+        Fr[1, :, iv] = -rho * _dense(rt.Cnc - scale * rt.Pd)
+        Fr[2, :, iz] = rho * np.kron(_dense(rt.W1), ab[None, :])
+        Fu = np.zeros((2, n_q, m))
+        Fru = np.zeros((2, 3, m))
+
+        # gust
+        col = {d.name: j for j, d in enumerate(self.inputs)}
+        g_states = []
+        if "gust" in col:
+            j = col["gust"]
+            if gust == "kussner":
+                ka, kb = np.asarray(kus.A), np.asarray(kus.b)
+                for gi, g in enumerate(groups):
+                    for t in range(kus.n_terms):
+                        s = ig.start + gi * kus.n_terms + t
+                        A[1, s, s] = -kb[t] / g.b
+                        B[0, s, j] = 1.0
+                        Fa[2, :, s] = rho * ka[t] * kb[t] * g.Gw
+                        Fr[2, :, s] = rho * ka[t] * kb[t] * rt.circ_groups[gi].Gw
+                        g_states.append(f"g{t + 1}_b{gi}")
+                direct = 1.0 - ka.sum()
+            else:
+                B[0, iz, j] = np.kron(np.asarray(am.Mz1.sum(axis=1)).ravel(), np.ones(T))
+                direct = scale
+            Fu[1, :, j] = rho * direct * sum(g.b * g.Gw for g in groups)
+            Fru[1, :, j] = rho * direct * sum(g.b * g.Gw for g in rt.circ_groups)
+
+        A[:, iv, :] = Fa
+        A[0, iv, iq] -= _dense(am.Ks)
+        B[:, iv, :] = Fu
+
+        # control inputs and servo states
+        s_next = ig.stop
+        servo_states: list[str] = []
+        self._servo_index: dict[int, int] = {}
+        for d in self.inputs:
+            j = col[d.name]
+            k = d.surface
+            if d.kind == "hinge_moment":
+                B[0, iv, j] += vec(hinge_moment_vector(model, k))
+            elif d.kind == "command":
+                force = vec(sum(ka * r for ka, r in actuator_rows(model, k)))
+                sv = self.servos[k]
+                name = model.wing.control_surfaces[k].name
+                if sv.order == 0:
+                    B[0, iv, j] += force
+                else:
+                    y = s_next
+                    self._servo_index[k] = y
+                    A[0, iv, y] += force
+                    w = sv.bandwidth
+                    if sv.order == 1:
+                        A[0, y, y] = -w
+                        B[0, y, j] = w
+                        servo_states.append(f"{name}_servo")
+                    else:
+                        A[0, y, y + 1] = 1.0
+                        A[0, y + 1, y] = -w * w
+                        A[0, y + 1, y + 1] = -2 * sv.damping * w
+                        B[0, y + 1, j] = w * w
+                        servo_states += [f"{name}_servo", f"{name}_servo_rate"]
+                    s_next += sv.order
+
+        # E^-1 applied once: A(V) = sum V^k Abar_k
+        einv = np.eye(n)
+        einv[:n0, :n0] = _block_inverse_dense(system, n0)
+        self._A = _Poly(A).left(einv)
+        self._B = _Poly(B).left(einv)
+        acc_x = _Poly(self._A.c[:, iv, :])  # qdd = acc_x x + acc_u u
+        acc_u = _Poly(self._B.c[:, iv, :])
+
+        # outputs: y = Cx x + Du u + Cacc qdd
+        p = len(self.outputs)
+        Cx = np.zeros((3, p, n))
+        Du = np.zeros((2, p, m))
+        Cacc = np.zeros((p, n_q))
+        mnc = _dense(am.Mnc)
+        for i, o in enumerate(self.outputs):
+            if o.kind == "sensor":
+                row = vec(sensor_row(model, o.sensor))
+                q = o.sensor.quantity
+                if q in ("displacement", "twist"):
+                    Cx[0, i, iq] = row
+                elif q in ("velocity", "twist_rate"):
+                    Cx[0, i, iv] = row
+                else:
+                    Cacc[i] = row
+            elif o.kind == "deflection":
+                Cx[0, i, iq] = vec(surface_mean_row(model, o.surface))
+            elif o.kind == "rate":
+                Cx[0, i, iv] = vec(surface_mean_row(model, o.surface))
+            elif o.kind == "modal":
+                Cx[0, i, iq] = vec(_dense(model.matrices.Ms) @ modes.shapes[:, o.index])
+            elif o.kind == "aero_hinge_moment":
+                e = vec(surface_unit(model, o.surface))
+                Cx[:, i, :] = np.einsum("j,kjl->kl", e, Fa)
+                Du[:, i, :] = np.einsum("j,kjl->kl", e, Fu)
+                Cacc[i] = -rho * (e @ mnc)
+            elif o.kind == "actuator_moment":
+                k = o.surface
+                for ka, r in actuator_rows(model, k):
+                    Cx[0, i, iq] -= ka * vec(r)
+                k_tot = sum(ka for ka, _ in actuator_rows(model, k))
+                for d in self.inputs:
+                    if d.surface != k:
+                        continue
+                    if d.kind == "hinge_moment":
+                        Du[0, i, col[d.name]] = 1.0
+                    elif d.kind == "command" and self.servos[k].order == 0:
+                        Du[0, i, col[d.name]] = k_tot
+                    elif d.kind == "command":
+                        Cx[0, i, self._servo_index[k]] = k_tot
+            elif o.kind == "root":
+                r = o.index
+                Cx[:, i, :] = Fr[:, r, :]
+                Cx[0, i, iq] -= _dense(rt.Ks)[r]
+                Du[:, i, :] = Fru[:, r, :]
+                Cacc[i] = -_dense(rt.Ms)[r] - rho * _dense(rt.Mnc)[r]
+        self._C = _Poly(Cx) + acc_x.left(Cacc)
+        self._D = _Poly(Du) + acc_u.left(Cacc)
+
+        self.state_labels = tuple(system.state_labels) + tuple(g_states) + tuple(servo_states)
+        self.input_labels = tuple(d.name for d in self.inputs)
+        self.output_labels = tuple(d.name for d in self.outputs)
+        self.units = {d.name: d.unit for d in self.inputs} | output_units(self.outputs)
+
+    def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` at ``speed`` [m/s]."""
+        v = check_number("speed", speed, unit="m/s", lo=0.0)
+        return self._A(v), self._B(v), self._C(v), self._D(v)
+
+    def at(self, speed: float):
+        """``control.StateSpace`` at ``speed`` [m/s], with named signals.
+
+        The returned object carries ``speed`` [m/s], ``density`` [kg/m^3] and
+        ``signal_units`` (dict) attributes.
+        """
+        import control
+
+        A, B, C, D = self.matrices(speed)
+        sys = control.StateSpace(
+            A,
+            B,
+            C,
+            D,
+            states=list(self.state_labels),
+            inputs=list(self.input_labels),
+            outputs=list(self.output_labels),
+            name=_system_name(self.model.wing.name, float(speed)),
+        )
+        _tag(sys, float(speed), self.density, self.units)
+        return sys
+
+    def family(self, speeds: Sequence[float]) -> list:
+        """Models at every speed of a grid [m/s] (no re-assembly)."""
+        return [self.at(v) for v in speeds]
+
+
+def _system_name(wing_name: str, speed: float) -> str:
+    """python-control system name (no dots allowed): e.g. ``goland_wing_V137p4``."""
+    slug = re.sub(r"\W+", "_", wing_name).strip("_").lower() or "wing"
+    return f"{slug}_V{speed:.6g}".replace(".", "p").replace("-", "m")
+
+
+def _tag(sys, speed: float, density: float, units: dict) -> None:
+    sys.speed = speed
+    sys.density = density
+    sys.signal_units = dict(units)
+
+
+def _block_inverse_dense(system, n0: int) -> np.ndarray:
+    from .system import _block_inverse
+
+    return _block_inverse(system.E, system.n_q)[:n0, :n0]
+
+
+def _servos(wing, servo, inputs) -> dict[int, Servo]:
+    """Servo of each surface with a commanded-deflection input."""
+    out = {}
+    for d in inputs:
+        if d.kind != "command":
+            continue
+        name = wing.control_surfaces[d.surface].name
+        if servo is None:
+            sv = Servo()
+        elif isinstance(servo, Servo):
+            sv = servo
+        elif isinstance(servo, dict):
+            sv = servo.get(name, Servo())
+        else:
+            raise InputError(f"servo = {servo!r}: expected a Servo or a dict of Servo by surface")
+        out[d.surface] = sv
+    return out
+
+
+_MODELS: dict = {}
+
+
+def _model_for(wing_or_model, n_elements: int, wagner: object):
+    from .aeroelastic import AeroelasticModel
+
+    if isinstance(wing_or_model, AeroelasticModel):
+        return wing_or_model
+    key = (wing_or_model, n_elements, wagner if isinstance(wagner, str) else None)
+    if key[2] is not None and key in _MODELS:
+        return _MODELS[key]
+    model = AeroelasticModel(wing_or_model, n_elements, wagner)
+    if key[2] is not None:
+        if len(_MODELS) > 16:
+            _MODELS.clear()
+        _MODELS[key] = model
+    return model
+
+
+def _builder_for(model, density, inputs, outputs, **kw) -> StateSpaceBuilder:
+    cache = model.__dict__.setdefault("_ss_builders", {})
+    try:
+        key = (float(density), _freeze(inputs), _freeze(outputs), _freeze(kw))
+        hash(key)
+    except TypeError:
+        return StateSpaceBuilder(model, density, inputs, outputs, **kw)
+    if key not in cache:
+        cache[key] = StateSpaceBuilder(model, density, inputs, outputs, **kw)
+    return cache[key]
+
+
+def _freeze(x):
+    if isinstance(x, dict):
+        return tuple(sorted((k, _freeze(v)) for k, v in x.items()))
+    if isinstance(x, (list, tuple)):
+        return tuple(_freeze(v) for v in x)
+    return x
+
+
+def statespace(
+    wing,
+    speed: float,
+    density: float,
+    inputs: Sequence[str] | None = None,
+    outputs: Sequence[str | Sensor] | None = None,
+    *,
+    n_elements: int = 10,
+    wagner: object = "rt_jones",
+    servo: Servo | dict | None = None,
+    gust: str = "kussner",
+    kussner: object = "sears_sparks",
+    n_modes: int | None = None,
+):
+    """Linear state-space model of a wing at one flight condition.
+
+    Parameters
+    ----------
+    wing : Wing or AeroelasticModel
+        A wing (meshed with ``n_elements`` and ``wagner``) or an existing model.
+    speed : float
+        Airspeed [m/s].
+    density : float
+        Air density [kg/m^3].
+    inputs, outputs :
+        Signal names, see :mod:`aeroservo.signals` (defaults: hinge moments and gust in; tip
+        leading/trailing-edge accelerations and tip twist out).
+    servo, gust, kussner, n_modes :
+        See :class:`StateSpaceBuilder`.
+
+    Returns
+    -------
+    control.StateSpace
+        With named states, inputs and outputs, and attributes ``speed``, ``density`` and
+        ``signal_units``. Builders are cached per model, so repeated calls are cheap.
+    """
+    model = _model_for(wing, n_elements, wagner)
+    b = _builder_for(
+        model, density, inputs, outputs, servo=servo, gust=gust, kussner=kussner, n_modes=n_modes
+    )
+    return b.at(speed)
+
+
+def statespace_family(
+    wing, speeds: Sequence[float], density: float, inputs=None, outputs=None, **kw
+):
+    """Models over a speed grid [m/s], e.g. for gain scheduling (no re-assembly).
+
+    Same parameters as :func:`statespace`; returns a list of ``control.StateSpace``.
+    """
+    n_el = kw.pop("n_elements", 10)
+    wag = kw.pop("wagner", "rt_jones")
+    model = _model_for(wing, n_el, wag)
+    return _builder_for(model, density, inputs, outputs, **kw).family(speeds)
+
+
+def discretize(sys, sample_rate: float):
+    """Zero-order-hold discretization at ``sample_rate`` [Hz]; names and tags are kept."""
+    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    d = sys.sample(1.0 / rate, method="zoh")
+    if hasattr(sys, "speed"):
+        _tag(d, sys.speed, sys.density, sys.signal_units)
+    return d
+
+
+def _export_dict(sys) -> dict:
+    return {
+        "A": np.asarray(sys.A),
+        "B": np.asarray(sys.B),
+        "C": np.asarray(sys.C),
+        "D": np.asarray(sys.D),
+        "state_names": np.array(sys.state_labels, dtype=object),
+        "input_names": np.array(sys.input_labels, dtype=object),
+        "output_names": np.array(sys.output_labels, dtype=object),
+        "input_units": np.array(
+            [getattr(sys, "signal_units", {}).get(n, "") for n in sys.input_labels], dtype=object
+        ),
+        "output_units": np.array(
+            [getattr(sys, "signal_units", {}).get(n, "") for n in sys.output_labels], dtype=object
+        ),
+        "speed": float(getattr(sys, "speed", np.nan)),
+        "density": float(getattr(sys, "density", np.nan)),
+        "dt": 0.0 if sys.dt in (0, None) else float(sys.dt),
+    }
+
+
+def export_mat(sys, path: str | Path) -> Path:
+    """Write ``A, B, C, D``, signal names and units, speed, density and dt to a MATLAB file."""
+    from scipy.io import savemat
+
+    from .fileio import atomic_write
+
+    data = _export_dict(sys)
+    return atomic_write(path, lambda p: savemat(p, data, do_compression=True))
+
+
+def export_npz(sys, path: str | Path) -> Path:
+    """Same content as :func:`export_mat` in a NumPy ``.npz`` file (names as str arrays)."""
+    from .fileio import atomic_write
+
+    data = {
+        k: (v.astype(str) if isinstance(v, np.ndarray) and v.dtype == object else v)
+        for k, v in _export_dict(sys).items()
+    }
+
+    def write(p: Path) -> None:
+        with open(p, "wb") as fh:
+            np.savez(fh, **data)
+
+    return atomic_write(path, write)
+
+
+def modal_controllability(sys, eigenvalue: complex) -> dict:
+    """Scale-invariant test of how each input reaches, and each output sees, one mode.
+
+    With right and left eigenvectors v, w of A for the eigenvalue nearest ``eigenvalue``, the
+    index of input j is ``|w^H b_j| / sum_i |w_i| |b_ij|`` and that of output i is
+    ``|c_i v| / sum_k |c_ik| |v_k|``: the inner product that decides controllability
+    (observability) divided by the bound on its rounding error. It does not change when states
+    are rescaled (units), it is 1 without cancellation and of the order of 1e-16 for a
+    mathematically zero coupling (a zero column of B, an unobservable mode). Accelerometer rows
+    typically give 1e-7..1e-5 because stiffness and inertia forces nearly cancel in a mode.
+
+    Returns
+    -------
+    dict
+        ``{"eigenvalue": lam, "inputs": {name: index}, "outputs": {name: index}}``.
+    """
+    A = np.asarray(sys.A)
+    lam, W, V = sla.eig(A, left=True, right=True)
+    i = int(np.argmin(np.abs(lam - eigenvalue)))
+    v, w = V[:, i], W[:, i]
+    B, C = np.asarray(sys.B), np.asarray(sys.C)
+
+    def index(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+        return np.divide(num, den, out=np.zeros_like(num), where=den > 0)
+
+    ctrb = index(np.abs(w.conj() @ B), np.abs(w) @ np.abs(B))
+    obsv = index(np.abs(C @ v), np.abs(C) @ np.abs(v))
+    return {
+        "eigenvalue": complex(lam[i]),
+        "inputs": dict(zip(sys.input_labels, ctrb.tolist(), strict=True)),
+        "outputs": dict(zip(sys.output_labels, obsv.tolist(), strict=True)),
+    }
