@@ -186,6 +186,7 @@ class StateSpaceBuilder:
         else:
             basis = None
         self.n_modes = n_modes
+        self.basis = basis
 
         def vec(v: np.ndarray) -> np.ndarray:  # generalized force / row in the used unknowns
             return v if basis is None else basis.T @ v

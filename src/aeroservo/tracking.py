@@ -73,8 +73,9 @@ class EigenTracker:
         self.n_q = system.n_q
         self.dense = system.n_states <= DENSE_LIMIT
         if self.dense:
-            self._E = system.E.toarray()
-            self._A = tuple(a.toarray() for a in (system.A0, system.A1, system.A2))
+            # complex copies: mixed real-complex products would convert at every iteration
+            self._E = system.E.toarray().astype(complex)
+            self._A = tuple(a.toarray().astype(complex) for a in (system.A0, system.A1, system.A2))
         else:
             self._E = system.E.tocsc()
             self._A = tuple(a.tocsc() for a in (system.A0, system.A1, system.A2))
@@ -144,7 +145,8 @@ class EigenTracker:
         The residual is evaluated only once the eigenvalue estimate has settled.
         """
         E = self._E
-        x = x0 / np.linalg.norm(x0)
+        x = np.asarray(x0, dtype=complex)
+        x = x / _norm(x)
         sigma = lam = lam0
         for _shift in range(max_shifts):
             solve = self._factor(A, sigma)
@@ -152,15 +154,13 @@ class EigenTracker:
             for _it in range(10):
                 y = solve(E @ x)
                 lam_new = sigma + 1.0 / np.vdot(x, y)
-                x = y / np.linalg.norm(y)
+                x = y / _norm(y)
                 dl = abs(lam_new - lam) / abs(lam_new)
                 lam = lam_new
                 if dl < 1e-9:
                     ax = A @ x
                     ex = E @ x
-                    res = np.linalg.norm(ax - lam * ex) / (
-                        np.linalg.norm(ax) + abs(lam) * np.linalg.norm(ex)
-                    )
+                    res = _norm(ax - lam * ex) / (_norm(ax) + abs(lam) * _norm(ex))
                     if res < self.tol or (dl <= 1e-10 and res < 1e-6):
                         return lam, x, True
                 if dl > 0.2 * prev_dl:
@@ -257,6 +257,11 @@ class EigenTracker:
             if not conv:
                 raise RuntimeError(f"eigenpair could not be followed to V = {speed:.6g} m/s")
         return lam_c, x_c
+
+
+def _norm(x: np.ndarray) -> float:
+    """2-norm of a complex vector (cheaper than ``np.linalg.norm`` for the small vectors here)."""
+    return float(np.sqrt(np.vdot(x, x).real))
 
 
 def _has_duplicates(lam: np.ndarray) -> bool:

@@ -1,0 +1,196 @@
+"""Linear-quadratic regulator (full-state feedback) with Bryson's-rule weights.
+
+``control.lqr`` gives the continuous gain (used for closed-loop flutter boundaries and Bode
+analysis) and ``control.dlqr`` the gain for the sampled loop, on the exact zero-order-hold model
+with the same weights.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import InputError, check_number
+from .plant import SampledPlant, select
+
+__all__ = ["Bryson", "bryson_weights", "StateFeedback", "lqr"]
+
+
+@dataclass(frozen=True)
+class Bryson:
+    """Bryson's rule: weight each signal by the inverse square of its allowed value.
+
+    Parameters
+    ----------
+    outputs : dict
+        ``{output name: allowed value}`` in the output's unit (e.g. ``{"tip_disp": 0.05}`` m).
+    inputs : dict
+        ``{control input name: allowed value}`` (e.g. ``{"aileron_hinge_moment": 500.0}`` N m).
+    state_weight : float
+        Small weight added on every state (times the trace of the output weight / n), to keep
+        the Riccati equation well posed when some states are not seen by the outputs.
+    """
+
+    outputs: dict
+    inputs: dict
+    state_weight: float = 1e-8
+
+    def __post_init__(self) -> None:
+        if not self.outputs or not self.inputs:
+            raise InputError("bryson: give at least one output and one input limit")
+        for kind in ("outputs", "inputs"):
+            for name, value in getattr(self, kind).items():
+                check_number(f"bryson.{kind}[{name!r}]", value, lo=0.0, lo_open=True)
+        check_number("bryson.state_weight", self.state_weight, lo=0.0)
+
+
+def bryson_weights(
+    sys, controls: Sequence[str], bryson: Bryson
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Q, R, N)`` for ``J = int x'Q x + u'R u + 2 x'N u`` from output and input limits.
+
+    Outputs with a direct feedthrough (accelerations) contribute cross and input terms.
+    """
+    for c in bryson.inputs:
+        if c not in controls:
+            raise InputError(f"bryson.inputs: {c!r} is not a control input {list(controls)}")
+    names = list(bryson.outputs)
+    _, _, C, D = select(sys, controls, names)
+    w = np.array([1.0 / bryson.outputs[n] ** 2 for n in names])
+    Q = C.T @ (w[:, None] * C)
+    N = C.T @ (w[:, None] * D)
+    R = D.T @ (w[:, None] * D) + np.diag(
+        [1.0 / bryson.inputs.get(c, np.inf) ** 2 for c in controls]
+    )
+    if np.any(np.diag(R) <= 0):
+        missing = [c for c in controls if c not in bryson.inputs]
+        raise InputError(f"bryson.inputs: give an allowed value for every control ({missing})")
+    Q = Q + bryson.state_weight * max(np.trace(Q) / Q.shape[0], 1e-300) * np.eye(Q.shape[0])
+    return 0.5 * (Q + Q.T), R, N
+
+
+@dataclass
+class StateFeedback:
+    """``u = -K x_design`` with ``x_design = state_map @ x_plant``.
+
+    Attributes
+    ----------
+    K : ndarray (n_controls, n_design)
+        Continuous-time gain (``control.lqr``).
+    Kd : ndarray (n_controls, n_design)
+        Gain of the sampled loop (``control.dlqr`` on the zero-order-hold model).
+    state_map : ndarray (n_design, n_plant)
+    controls : tuple of str
+    dt : float
+        Sample period [s].
+    closed_loop_poles : ndarray
+        Continuous closed-loop poles of the design model.
+    """
+
+    K: np.ndarray
+    Kd: np.ndarray
+    state_map: np.ndarray
+    controls: tuple
+    dt: float
+    closed_loop_poles: np.ndarray = field(default_factory=lambda: np.array([]))
+    sensors: tuple = ()
+    needs_state: bool = True
+
+    @property
+    def gain(self) -> np.ndarray:
+        """Sampled-loop gain on the plant state: ``u = -gain @ x_plant``."""
+        return self.Kd @ self.state_map
+
+    @property
+    def gain_continuous(self) -> np.ndarray:
+        return self.K @ self.state_map
+
+    # sampled-controller protocol used by the simulator
+    def reset(self) -> None:
+        self.status = {}
+
+    def command(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return -(self.gain @ x)
+
+    def update(self, y: np.ndarray, u: np.ndarray) -> None:
+        pass
+
+
+def _balanced_lqr(solver, A, B, Q, R, N) -> tuple[np.ndarray, np.ndarray]:
+    """Riccati solution in coordinates equilibrated by a diagonal similarity x = T x~.
+
+    Structural models mix stiff and soft unknowns (entries of A from 1e-3 to 1e10); SLICOT's
+    Riccati solvers reject them as poorly scaled unless balanced first. The gain maps back as
+    ``K = K~ T^-1`` and the closed-loop poles are unchanged.
+    """
+    _, T = sla.matrix_balance(A, permute=False, separate=True)
+    t = T[0] if isinstance(T, tuple) else np.asarray(T)
+    At = A * (1.0 / t)[:, None] * t[None, :]
+    Bt = B / t[:, None]
+    Qt = Q * t[:, None] * t[None, :]
+    Nt = N * t[:, None]
+    Kt, _, E = solver(At, Bt, Qt, R, Nt)
+    return np.asarray(Kt) / t[None, :], np.asarray(E)
+
+
+def lqr(
+    sys,
+    controls: Sequence[str],
+    *,
+    Q: np.ndarray | None = None,
+    R: np.ndarray | None = None,
+    bryson: Bryson | None = None,
+    sample_rate: float = 1000.0,
+    state_map: np.ndarray | None = None,
+) -> StateFeedback:
+    """Full-state-feedback LQR on a design model.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Continuous design model (full or reduced, e.g. from :class:`StateSpaceBuilder` with
+        ``n_modes``), with the named control inputs.
+    controls : sequence of str
+        Inputs the controller drives (e.g. ``["aileron_hinge_moment"]``).
+    Q, R : ndarray, optional
+        Weights on design states and controls (give these, or ``bryson``).
+    bryson : Bryson, optional
+        Output and input limits (Bryson's rule).
+    sample_rate : float
+        Sampling rate of the discrete gain [Hz].
+    state_map : ndarray, optional
+        ``x_design = state_map @ x_plant`` (see :func:`aeroservo.design.plant.state_map`);
+        identity by default.
+
+    Returns
+    -------
+    StateFeedback
+    """
+    import control
+
+    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    A, B, _, _ = select(sys, controls, [])
+    n = A.shape[0]
+    if bryson is not None:
+        if Q is not None or R is not None:
+            raise InputError("lqr: give either Q and R, or bryson, not both")
+        Q, R, N = bryson_weights(sys, controls, bryson)
+    else:
+        if Q is None or R is None:
+            raise InputError("lqr: give Q and R, or bryson")
+        Q, R = np.atleast_2d(Q).astype(float), np.atleast_2d(R).astype(float)
+        N = np.zeros((n, B.shape[1]))
+        if Q.shape != (n, n) or R.shape != (B.shape[1],) * 2:
+            raise InputError(f"lqr: Q must be {n}x{n} and R {B.shape[1]}x{B.shape[1]}")
+    K, E = _balanced_lqr(control.lqr, A, B, Q, R, N)
+    sp = SampledPlant.from_statespace(sys, 1.0 / rate, controls, (), [])
+    Kd, _ = _balanced_lqr(control.dlqr, sp.Phi, sp.Gu, Q / rate, R / rate, N / rate)
+    T = np.eye(n) if state_map is None else np.asarray(state_map)
+    if T.shape[0] != n:
+        raise InputError(f"lqr: state_map has {T.shape[0]} rows, the design model {n} states")
+    return StateFeedback(
+        np.asarray(K), np.asarray(Kd), T, tuple(controls), 1.0 / rate, np.asarray(E)
+    )

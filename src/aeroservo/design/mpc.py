@@ -1,0 +1,313 @@
+"""Constrained linear MPC for flutter suppression, solved as a QP with casadi.
+
+At each sample the state of the (reduced) design model is estimated by the Kalman filter of
+:mod:`aeroservo.design.lqg`, then the condensed quadratic program
+
+``min_U  sum_{k=0}^{N-1} (x_k'Q x_k + 2 x_k'N u_k + u_k'R u_k) + x_N'P x_N + w_s |S|^2``
+
+subject to the hard limits ``|u_k| <= u_max`` and ``|u_k - u_{k-1}| <= du_max dt`` and the soft
+output limits ``|z_k| <= z_max + s_k`` (slack ``s_k >= 0``, so the problem is never
+infeasible) is solved over the horizon N. P is the discrete Riccati solution (stabilizing
+terminal cost). The QP is warm-started from the previous, shifted solution.
+
+Failure handling: if the solver reports anything but success, the controller applies the
+**saturated terminal LQR law** ``u = sat(-K_P x)`` (rate and magnitude limits respected),
+records ``fallback=True`` with the solver's status for that sample, and carries on.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, check_int, check_number
+from .lqg import KalmanFilter, kalman_filter, solve_dare
+from .lqr import Bryson, bryson_weights
+from .plant import Limits, SampledPlant, select
+
+__all__ = ["MPCController", "mpc", "SOLVERS"]
+
+SOLVERS = {
+    "qpoases": {"printLevel": "none", "sparse": False, "error_on_fail": False},
+    "osqp": {
+        "osqp": {"verbose": False, "eps_abs": 1e-7, "eps_rel": 1e-7, "polish": True},
+        "warm_start_primal": True,
+        "warm_start_dual": True,
+        "error_on_fail": False,
+    },
+    "highs": {"highs": {"output_flag": False}, "error_on_fail": False},
+    "daqp": {"error_on_fail": False},
+}
+"""casadi conic solvers tried and their options (see ``bench/bench_mpc.py`` for timings)."""
+
+
+@dataclass
+class MPCController:
+    """Sampled MPC controller (use :func:`mpc` to build one).
+
+    Attributes
+    ----------
+    horizon : int
+    controls, sensors : tuple of str
+    dt : float
+    solver_name : str
+    solve_times : list of float
+        Wall time of each QP solve [s].
+    statuses : list of str
+        Solver return status of each sample.
+    fallbacks : int
+        Samples at which the fallback law was applied.
+    """
+
+    horizon: int
+    controls: tuple
+    sensors: tuple
+    dt: float
+    kf: KalmanFilter
+    n_x: int
+    H: np.ndarray
+    G: np.ndarray
+    A_con: np.ndarray
+    Tx_out: np.ndarray
+    z_max: np.ndarray
+    u_max: np.ndarray
+    du_max: np.ndarray
+    K_fallback: np.ndarray
+    solver_name: str
+    solver: object = None
+    needs_state: bool = False
+    solve_times: list = field(default_factory=list)
+    statuses: list = field(default_factory=list)
+    fallbacks: int = 0
+    _warm: dict | None = None
+
+    def reset(self) -> None:
+        self.kf.reset()
+        self.solve_times = []
+        self.statuses = []
+        self.fallbacks = 0
+        self._warm = None
+        self.last_status = None
+
+    def _bounds(self, x0: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, ...]:
+        N, m = self.horizon, self.u_max.size
+        ns = self.z_max.size * N
+        lbx = np.r_[np.tile(-self.u_max, N), np.zeros(ns)]
+        ubx = np.r_[np.tile(self.u_max, N), np.full(ns, np.inf)]
+        du = np.tile(self.du_max * self.dt, N)
+        shift = np.zeros(N * m)
+        shift[:m] = h
+        lb_rate, ub_rate = -du + shift, du + shift
+        if ns:
+            zfree = self.Tx_out @ x0
+            zm = np.tile(self.z_max, N)
+            lb = np.r_[lb_rate, np.full(ns, -np.inf), -zm - zfree]
+            ub = np.r_[ub_rate, zm - zfree, np.full(ns, np.inf)]
+        else:
+            lb, ub = lb_rate, ub_rate
+        return lbx, ubx, lb, ub
+
+    def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
+        xi = self.kf.correct(y)
+        x0, h = xi[: self.n_x], xi[self.n_x :]
+        m = self.u_max.size
+        g = 2.0 * (self.G @ x0)
+        ns = self.z_max.size * self.horizon
+        g = np.r_[g, np.zeros(ns)]
+        lbx, ubx, lba, uba = self._bounds(x0, h)
+        args = {"h": self._H, "a": self._A, "g": g, "lbx": lbx, "ubx": ubx, "lba": lba, "uba": uba}
+        if self._warm is not None:
+            args.update(self._warm)
+        t0 = time.perf_counter()
+        sol = self.solver(**args)
+        dt_solve = time.perf_counter() - t0
+        stats = self.solver.stats()
+        ok = bool(stats.get("success", False))
+        status = str(stats.get("return_status", "unknown"))
+        U = np.asarray(sol["x"]).ravel()
+        if ok and np.all(np.isfinite(U)):
+            u0 = U[:m]
+            nu = m * self.horizon
+            shifted = np.r_[U[m:nu], U[nu - m : nu], U[nu:]]
+            self._warm = {
+                "x0": shifted,
+                "lam_x0": np.asarray(sol["lam_x"]).ravel(),
+                "lam_a0": np.asarray(sol["lam_a"]).ravel(),
+            }
+            fallback = False
+        else:
+            u_lqr = -(self.K_fallback @ x0)
+            u0 = np.clip(u_lqr, h - self.du_max * self.dt, h + self.du_max * self.dt)
+            u0 = np.clip(u0, -self.u_max, self.u_max)
+            self._warm = None
+            self.fallbacks += 1
+            fallback = True
+        self.solve_times.append(dt_solve)
+        self.statuses.append(status)
+        self.last_status = {"status": status, "solve_time": dt_solve, "fallback": fallback}
+        return u0
+
+    def update(self, y: np.ndarray, u: np.ndarray) -> None:
+        self.kf.predict(u)
+
+
+def _condensed(Phi, Gu, Q, R, N, P, horizon):
+    """Matrices of the condensed QP: J = U'HU + 2 x0'G'U + const (G: (N m, n))."""
+    n, m = Gu.shape
+    # X_all = [x_0..x_N] = Tx x0 + Tu U
+    Tx = np.zeros(((horizon + 1) * n, n))
+    Tu = np.zeros(((horizon + 1) * n, horizon * m))
+    Tx[:n] = np.eye(n)
+    powers = [np.eye(n)]
+    for k in range(1, horizon + 1):
+        powers.append(Phi @ powers[-1])
+        Tx[k * n : (k + 1) * n] = powers[k]
+        for j in range(k):
+            Tu[k * n : (k + 1) * n, j * m : (j + 1) * m] = powers[k - 1 - j] @ Gu
+    Qb = np.zeros(((horizon + 1) * n,) * 2)
+    Nb = np.zeros(((horizon + 1) * n, horizon * m))
+    for k in range(horizon):
+        if k > 0:
+            Qb[k * n : (k + 1) * n, k * n : (k + 1) * n] = Q
+        Nb[k * n : (k + 1) * n, k * m : (k + 1) * m] = N
+    Qb[horizon * n :, horizon * n :] = P
+    Rb = np.kron(np.eye(horizon), R)
+    H = Tu.T @ Qb @ Tu + Rb + Tu.T @ Nb + Nb.T @ Tu
+    G = Tu.T @ Qb @ Tx + Nb.T @ Tx
+    return 0.5 * (H + H.T), G, Tx, Tu
+
+
+def mpc(
+    sys,
+    controls: Sequence[str],
+    sensors: Sequence[str],
+    *,
+    limits: Limits,
+    process_noise: dict,
+    sensor_noise: dict,
+    horizon: int = 20,
+    bryson: Bryson | None = None,
+    Q: np.ndarray | None = None,
+    R: np.ndarray | None = None,
+    soft_outputs: dict | None = None,
+    slack_weight: float = 1e4,
+    sample_rate: float = 1000.0,
+    solver: str = "qpoases",
+) -> MPCController:
+    """Build a constrained MPC controller on a (reduced) continuous design model.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Continuous design model (e.g. a modal truncation, with the same sensor filters as the
+        plant) with the controls, the disturbance inputs of ``process_noise`` and the sensors.
+    controls, sensors : sequence of str
+    limits : Limits
+        Hard magnitude and rate limits of every control (both are required).
+    process_noise, sensor_noise : dict
+        Kalman filter noise variances (see :func:`aeroservo.design.lqg.kalman_filter`).
+    horizon : int
+        Prediction horizon N [samples].
+    bryson, Q, R :
+        Stage cost weights (see :func:`aeroservo.design.lqr.lqr`).
+    soft_outputs : dict, optional
+        ``{output name: limit}`` soft limits on outputs without direct feedthrough.
+    slack_weight : float
+        Weight of the squared slack, relative to the largest diagonal entry of the Hessian.
+    sample_rate : float
+        [Hz].
+    solver : str
+        casadi conic solver: ``"qpoases"`` (default, active set, warm started), ``"osqp"``,
+        ``"highs"``, ``"daqp"``.
+
+    Returns
+    -------
+    MPCController
+    """
+    import casadi as ca
+
+    horizon = check_int("horizon", horizon, lo=1, hi=500)
+    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    check_number("slack_weight", slack_weight, lo=0.0, lo_open=True)
+    if solver not in SOLVERS:
+        raise InputError(f"solver = {solver!r}: choose one of {sorted(SOLVERS)}")
+    dt = 1.0 / rate
+    u_max, du_max = limits.arrays(controls)
+    if not (np.all(np.isfinite(u_max)) and np.all(np.isfinite(du_max))):
+        raise InputError("mpc: limits must give a magnitude and a rate limit for every control")
+    A, B, _, _ = select(sys, controls, [])
+    n, m = B.shape
+    if bryson is not None:
+        Q, R, Ncross = bryson_weights(sys, controls, bryson)
+    elif Q is None or R is None:
+        raise InputError("mpc: give Q and R, or bryson")
+    else:
+        Q, R, Ncross = np.atleast_2d(Q), np.atleast_2d(R), np.zeros((n, m))
+    sp = SampledPlant.from_statespace(sys, dt, controls, tuple(process_noise), list(sensors))
+    kf = kalman_filter(sp, sensors, process_noise, sensor_noise)
+    Qd, Rd, Nd = Q * dt, R * dt, Ncross * dt
+    # terminal cost: DARE with the cross term removed by a change of input
+    Rinv_Nt = np.linalg.solve(Rd, Nd.T)
+    P = solve_dare(sp.Phi - sp.Gu @ Rinv_Nt, sp.Gu, Qd - Nd @ Rinv_Nt, Rd)
+    K_fb = np.linalg.solve(Rd + sp.Gu.T @ P @ sp.Gu, sp.Gu.T @ P @ sp.Phi + Nd.T)
+    H, G, Tx, Tu = _condensed(sp.Phi, sp.Gu, Qd, Rd, Nd, P, horizon)
+
+    names = list(soft_outputs or {})
+    _, _, Cz, Dz = select(sys, controls, names)
+    if names and np.any(Dz != 0):
+        raise InputError(
+            f"soft_outputs: {names} must not have a direct feedthrough from the controls"
+        )
+    z_max = np.array(
+        [check_number(f"soft_outputs[{k!r}]", soft_outputs[k], lo=0.0, lo_open=True) for k in names]
+    )
+    p = len(names)
+    nu = horizon * m
+    ns = horizon * p
+    Hs = np.zeros((nu + ns, nu + ns))
+    Hs[:nu, :nu] = H
+    if ns:
+        Hs[nu:, nu:] = slack_weight * np.max(np.diag(H)) * np.eye(ns)
+    # rate rows
+    Dm = np.eye(nu) - np.eye(nu, k=-m)
+    rows = [np.hstack([Dm, np.zeros((nu, ns))])]
+    Tx_out = np.zeros((ns, n))
+    if ns:
+        Czb = np.kron(np.eye(horizon), Cz)
+        Tu_out = Czb @ Tu[n:]  # outputs at x_1..x_N
+        Tx_out = Czb @ Tx[n:]
+        rows.append(np.hstack([Tu_out, -np.eye(ns)]))
+        rows.append(np.hstack([Tu_out, np.eye(ns)]))
+    A_con = np.vstack(rows)
+    H_full = 2.0 * Hs
+    conic = ca.conic(
+        "aeroservo_mpc",
+        solver,
+        {"h": ca.DM(H_full).sparsity(), "a": ca.DM(A_con).sparsity()},
+        SOLVERS[solver],
+    )
+    ctrl = MPCController(
+        horizon=horizon,
+        controls=tuple(controls),
+        sensors=tuple(sensors),
+        dt=dt,
+        kf=kf,
+        n_x=n,
+        H=H_full,
+        G=G,
+        A_con=A_con,
+        Tx_out=Tx_out,
+        z_max=z_max,
+        u_max=u_max,
+        du_max=du_max,
+        K_fallback=K_fb,
+        solver_name=solver,
+        solver=conic,
+    )
+    ctrl._H = ca.DM(H_full)
+    ctrl._A = ca.DM(A_con)
+    ctrl.reset()
+    return ctrl
