@@ -289,15 +289,12 @@ class _Branch:
     def re(self, v: float, k: int) -> float:
         return float(self.eig(v, k).real)
 
-    def crossing(self, k: int, a: float, b: float, rising: bool, rtol: float) -> Crossing:
-        """Root of Re(lambda) in [a, b] (inside grid interval k)."""
-        from scipy.optimize import brentq
-
-        vs = brentq(self.re, a, b, args=(k,), xtol=rtol * b, rtol=1e-15)
-        lam_c = self.eig(vs, k)
+    def crossing(self, v: float, k: int, rising: bool) -> Crossing:
+        """The crossing at speed v (a root of Re(lambda) inside grid interval k)."""
+        lam_c = self.eig(v, k)
         osc = abs(lam_c.imag) > 1e-6 * max(abs(lam_c.real), 1.0)
         kind = ("onset" if rising else "recovery") if osc else "divergence"
-        return Crossing(float(vs), abs(lam_c.imag) / (2 * np.pi) if osc else 0.0, self.j, kind)
+        return Crossing(float(v), abs(lam_c.imag) / (2 * np.pi) if osc else 0.0, self.j, kind)
 
 
 HUMP_ZETA = 0.05
@@ -306,39 +303,77 @@ points (the step control keeps eigenvalue changes per step below 10 %, so a hump
 zero cannot hide behind grid values further from zero than this)."""
 
 
-def _find_crossings(tracker: EigenTracker, tr: TrackedModes, rtol: float) -> list[Crossing]:
-    from scipy.optimize import minimize_scalar
+def sign_changes(
+    fun: Callable[[float, int], float],
+    V: np.ndarray,
+    g: np.ndarray,
+    zeta: np.ndarray,
+    rtol: float,
+    first: int = 1,
+) -> list[tuple[float, bool, int]]:
+    """Roots in speed of a continuous stability measure known on a grid, humps included.
 
+    Parameters
+    ----------
+    fun : callable
+        ``fun(v, k)``: the measure (e.g. Re(lambda) [1/s]) at speed v inside grid interval k.
+    V : ndarray
+        Increasing grid speeds [m/s].
+    g : ndarray
+        The measure on the grid (negative: stable).
+    zeta : ndarray
+        Damping ratio on the grid; interior extrema with ``|zeta| < HUMP_ZETA`` that do not
+        change sign on the grid are refined (a hump that crosses zero between grid points).
+    rtol : float
+        Relative tolerance on the roots.
+    first : int
+        Index of the first grid point used in the sign test (1 skips V = 0, where an undamped
+        structure has Re = 0 exactly).
+
+    Returns
+    -------
+    list of (speed, rising, k)
+        Root [m/s], whether the measure goes from negative to positive, grid interval.
+    """
+    from scipy.optimize import brentq, minimize_scalar
+
+    def root(k: int, a: float, b: float) -> float:
+        return float(brentq(fun, a, b, args=(k,), xtol=rtol * b, rtol=1e-15))
+
+    out = []
+    for k in range(first, V.size - 1):
+        if (g[k] < 0) != (g[k + 1] < 0):
+            out.append((root(k, V[k], V[k + 1]), bool(g[k] < 0), k))
+    for k in range(first + 1, V.size - 1):
+        for sgn in (1.0, -1.0):
+            gk = sgn * g
+            if not (gk[k] >= gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
+                continue
+            if abs(zeta[k]) >= HUMP_ZETA:
+                continue
+            # search both grid intervals around the extreme, continuing from the left one
+            sol = minimize_scalar(
+                lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
+                bounds=(V[k - 1], V[k + 1]),
+                method="bounded",
+                options={"xatol": rtol * V[k + 1]},
+            )
+            if -sol.fun > 0:
+                vpk = float(sol.x)
+                kk = k - 1 if vpk < V[k] else k
+                out.append((root(kk, V[kk], vpk), sgn > 0, kk))
+                out.append((root(kk, vpk, V[kk + 1]), sgn < 0, kk))
+    return sorted(out)
+
+
+def _find_crossings(tracker: EigenTracker, tr: TrackedModes, rtol: float) -> list[Crossing]:
     V = tr.speeds
     out: list[Crossing] = []
     for j in range(tr.eigenvalues.shape[1]):
         br = _Branch(tracker, tr, j)
-        g = br.lam.real
-        # V = 0 has Re = 0 exactly for an undamped structure: start the sign test at index 1
-        for k in range(1, V.size - 1):
-            if (g[k] < 0) != (g[k + 1] < 0):
-                out.append(br.crossing(k, V[k], V[k + 1], rising=g[k] < 0, rtol=rtol))
-        # humps (local max of Re below zero) or dips (local min above zero) between grid points
-        zeta = -g / np.maximum(np.abs(br.lam), 1e-300)
-        for k in range(2, V.size - 1):
-            for sgn in (1.0, -1.0):
-                gk = sgn * g
-                if not (gk[k] >= gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
-                    continue
-                if abs(zeta[k]) >= HUMP_ZETA:
-                    continue
-                # search both grid intervals around the extreme, continuing from the left one
-                sol = minimize_scalar(
-                    lambda v, s=sgn, k=k, br=br: -s * br.re(v, k - 1 if v < V[k] else k),
-                    bounds=(V[k - 1], V[k + 1]),
-                    method="bounded",
-                    options={"xatol": rtol * V[k + 1]},
-                )
-                if -sol.fun > 0:
-                    vpk = float(sol.x)
-                    kk = k - 1 if vpk < V[k] else k
-                    out.append(br.crossing(kk, V[kk], vpk, rising=sgn > 0, rtol=rtol))
-                    out.append(br.crossing(kk, vpk, V[kk + 1], rising=sgn < 0, rtol=rtol))
+        zeta = -br.lam.real / np.maximum(np.abs(br.lam), 1e-300)
+        for v, rising, k in sign_changes(br.re, V, br.lam.real, zeta, rtol):
+            out.append(br.crossing(v, k, rising))
     out.sort(key=lambda c: c.speed)
     return out
 

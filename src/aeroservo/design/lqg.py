@@ -151,10 +151,10 @@ class OutputFeedback:
     kf : KalmanFilter
     controls, sensors : tuple of str
     dt : float
-    compensator : control.StateSpace
-        Discrete compensator from sensors to controls (valid while no limit is active).
-    compensator_continuous : control.StateSpace
-        Continuous-time LQG with the same weights (noise intensities = variances x dt).
+    continuous : dict
+        Pieces of the continuous LQG (design model ``A, B, C, D``, gains ``K``, ``L``).
+    design_speed : float
+        Speed of the design model [m/s].
     """
 
     K: np.ndarray
@@ -162,9 +162,21 @@ class OutputFeedback:
     controls: tuple
     sensors: tuple
     dt: float
-    compensator: object = None
-    compensator_continuous: object = None
+    continuous: dict = field(default_factory=dict)
+    design_speed: float = float("nan")
     needs_state: bool = False
+
+    @property
+    def compensator(self):
+        """Discrete compensator (``control.StateSpace``) from sensors to controls, valid while
+        no actuator limit is active."""
+        return discrete_compensator(self.K, self.kf, self.dt, self.sensors, self.controls)
+
+    @property
+    def compensator_continuous(self):
+        """Continuous-time LQG compensator with the same weights (noise intensities =
+        variances x dt)."""
+        return continuous_compensator(self.continuous, self.sensors, self.controls)
 
     def reset(self) -> None:
         self.kf.reset()
@@ -231,34 +243,63 @@ def lqg(
     Na[:n] = N
     Kd, _ = _balanced_lqr(control.dlqr, Ad, Bu, Qa * dt, R * dt, Na * dt)
 
-    # linear compensator: xi- state; c = -K (I - M Ca) xi- - K M y
-    I = np.eye(n + m)
-    F = I - kf.M @ Ca
-    Ac = (Ad - Bu @ Kd) @ F
-    Bc = (Ad - Bu @ Kd) @ kf.M
-    comp = control.ss(
-        Ac, Bc, -Kd @ F, -Kd @ kf.M, dt, inputs=list(sensors), outputs=list(controls), name="lqg"
-    )
-
     # continuous counterpart (for Bode, margins, closed-loop flutter boundaries)
     Kc, _ = _balanced_lqr(control.lqr, A, B, Q, R, N)
-    _, Bd_c, C_s, D_s = select(sys, dist, list(sensors))
+    _, Bd_c, C_s, _ = select(sys, dist, list(sensors))
     _, _, _, D_u = select(sys, controls, list(sensors))
     Wc = np.diag([process_noise[d] for d in dist]) * dt
     Vc = np.diag([sensor_noise[s] for s in sensors]) * dt
     L = _continuous_kalman(A, Bd_c, C_s, Wc, Vc)
-    Ak = A - B @ Kc - L @ C_s + L @ D_u @ Kc
-    comp_c = control.ss(
+    return OutputFeedback(
+        Kd,
+        kf,
+        tuple(controls),
+        tuple(sensors),
+        dt,
+        continuous={"A": A, "B": B, "C": C_s, "D": D_u, "K": Kc, "L": L},
+        design_speed=float(getattr(sys, "speed", np.nan)),
+    )
+
+
+def discrete_compensator(K, kf: KalmanFilter, dt: float, sensors, controls):
+    """Linear discrete LQG compensator (filter form) as a ``control.StateSpace``.
+
+    State: the a-priori estimate ``xi-``; ``c = -K (I - M Ca) xi- - K M y`` and
+    ``xi-[k+1] = (Ad - Bu K)(I - M Ca) xi- + (Ad - Bu K) M y``.
+    """
+    import control
+
+    F = np.eye(kf.Ad.shape[0]) - kf.M @ kf.Ca
+    AK = kf.Ad - kf.Bu @ K
+    return control.ss(
+        AK @ F,
+        AK @ kf.M,
+        -K @ F,
+        -K @ kf.M,
+        dt,
+        inputs=list(sensors),
+        outputs=list(controls),
+        name="lqg",
+    )
+
+
+def continuous_compensator(c: dict, sensors, controls):
+    """Continuous LQG compensator from the pieces ``A, B, C, D`` (design model from the
+    controls to the sensors), ``K`` (LQR gain) and ``L`` (Kalman gain)."""
+    import control
+
+    Ak = c["A"] - c["B"] @ c["K"] - c["L"] @ c["C"] + c["L"] @ c["D"] @ c["K"]
+    comp = control.ss(
         Ak,
-        L,
-        -Kc,
-        np.zeros((m, len(sensors))),
+        c["L"],
+        -c["K"],
+        np.zeros((c["K"].shape[0], len(sensors))),
         inputs=list(sensors),
         outputs=list(controls),
         name="lqg_continuous",
     )
-    comp_c.K, comp_c.L = Kc, L
-    return OutputFeedback(Kd, kf, tuple(controls), tuple(sensors), dt, comp, comp_c)
+    comp.K, comp.L = c["K"], c["L"]
+    return comp
 
 
 def _continuous_kalman(A, G, C, W, V) -> np.ndarray:

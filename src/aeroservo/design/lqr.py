@@ -98,6 +98,7 @@ class StateFeedback:
     closed_loop_poles: np.ndarray = field(default_factory=lambda: np.array([]))
     sensors: tuple = ()
     needs_state: bool = True
+    design_speed: float = float("nan")
 
     @property
     def gain(self) -> np.ndarray:
@@ -192,5 +193,11 @@ def lqr(
     if T.shape[0] != n:
         raise InputError(f"lqr: state_map has {T.shape[0]} rows, the design model {n} states")
     return StateFeedback(
-        np.asarray(K), np.asarray(Kd), T, tuple(controls), 1.0 / rate, np.asarray(E)
+        np.asarray(K),
+        np.asarray(Kd),
+        T,
+        tuple(controls),
+        1.0 / rate,
+        np.asarray(E),
+        design_speed=float(getattr(sys, "speed", np.nan)),
     )

@@ -79,6 +79,7 @@ class MPCController:
     solver_name: str
     solver: object = None
     needs_state: bool = False
+    is_linear: bool = False
     solve_times: list = field(default_factory=list)
     statuses: list = field(default_factory=list)
     fallbacks: int = 0
