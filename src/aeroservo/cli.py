@@ -74,7 +74,40 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("-n", type=_positive_int, default=6, help="number of modes (default 6)")
     m.add_argument("--json", action="store_true")
 
-    sub.add_parser("examples", help="list the built-in wings")
+    for name, helptext in (
+        ("run", "run a scenario of any kind (flutter, simulate, trade)"),
+        ("simulate", "run a closed-loop time simulation scenario"),
+        ("trade", "run a trade-study scenario on Dask"),
+    ):
+        r = sub.add_parser(name, help=helptext, description=helptext.capitalize() + ".")
+        r.add_argument("scenario", help="scenario file (.toml), see docs/scenarios.md")
+        r.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
+        r.add_argument("--json", action="store_true", help="print the summary as JSON")
+        r.add_argument(
+            "--quick",
+            action="store_true",
+            help="fast settings for smoke tests (short simulation, coarse grids, 2 values per "
+            "trade parameter)",
+        )
+        r.add_argument(
+            "--progress",
+            action=argparse.BooleanOptionalAction,
+            default=None,
+            help="progress bars on stderr (default: when stderr is a terminal)",
+        )
+        if name in ("run", "trade"):
+            r.add_argument(
+                "--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://host:port"
+            )
+            r.add_argument(
+                "--workers", type=_positive_int, help="LocalCluster workers (default: scenario)"
+            )
+
+    pl = sub.add_parser("plot", help="re-plot a saved simulation result (.npz)")
+    pl.add_argument("result", help="result file written by 'aeroservo simulate'")
+    pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
+
+    sub.add_parser("examples", help="list the built-in wings and the shipped scenarios")
     return p
 
 
@@ -167,12 +200,112 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 
 
 def _cmd_examples(args: argparse.Namespace) -> int:
-    from .examples import BUILTIN_WINGS
+    from .examples import BUILTIN_WINGS, shipped_scenarios
 
     print("built-in wings:")
     for name, fn in BUILTIN_WINGS.items():
         doc = (fn.__doc__ or "").strip().splitlines()[0]
         print(f"  {name:16s} {doc}")
+    found = shipped_scenarios()
+    if found:
+        print(f"scenarios ({found[0][0].parent}):")
+        for path, kind, title in found:
+            print(f"  {path.name:32s} {kind:9s} {title}")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .runs import run_scenario
+    from .scenario import load_scenario, quick
+
+    scenario = load_scenario(args.scenario)
+    if args.command != "run" and scenario.kind != args.command:
+        raise InputError(
+            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo "
+            f"{'run' if scenario.kind == 'flutter' else scenario.kind}' for it"
+        )
+    if args.quick:
+        scenario = quick(scenario)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    progress = sys.stderr.isatty() if args.progress is None else args.progress
+    summary = run_scenario(
+        scenario,
+        out,
+        progress=progress,
+        scheduler=getattr(args, "scheduler", None),
+        workers=getattr(args, "workers", None),
+    )
+    if args.json:
+        from .runs import _dumps
+
+        print(_dumps(summary))
+    else:
+        print(_readable(summary))
+    return 0
+
+
+def _readable(s: dict) -> str:
+    """Short human-readable summary of a run."""
+
+    def f(v, unit="", fmt=".5g"):
+        return "none" if v is None else f"{v:{fmt}}{unit}"
+
+    lines = [f"{s.get('scenario', '')} [{s.get('kind')}]"]
+    if s["kind"] == "flutter":
+        lines.append(
+            f"  flutter {f(s['flutter_speed'], ' m/s')} at {f(s['flutter_frequency'], ' Hz')}"
+            f" ({s.get('flutter_mode')}); divergence {f(s['divergence_speed'], ' m/s')}"
+        )
+        if "pk_exact_theodorsen" in s:
+            pk = s["pk_exact_theodorsen"]
+            lines.append(f"  p-k, exact C(k): flutter {f(pk['flutter_speed'], ' m/s')}")
+    elif s["kind"] == "simulate":
+        lines.append(
+            f"  {s['controller']} at {s['speed']:.5g} m/s "
+            f"(open-loop flutter {f(s['open_loop_flutter_speed'], ' m/s')})"
+        )
+        for name, v in s["signals"].items():
+            unit = s["units"].get(name, "")
+            lines.append(
+                f"  {name:24s} peak {v['peak']:10.4g} {unit:6s} rms {v['rms']:10.4g}  "
+                f"last/first {v['growth']:.3g}"
+            )
+        if "response" in s:
+            lines.append(f"  response {s['response']}")
+        if "mpc" in s:
+            m = s["mpc"]
+            lines.append(
+                f"  MPC solve time median {m['solve_time_median'] * 1e3:.3f} ms, "
+                f"p99 {m['solve_time_p99'] * 1e3:.3f} ms, fallbacks {m['fallbacks']}"
+            )
+        if "closed_loop" in s:
+            c = s["closed_loop"]
+            lines.append(
+                f"  closed-loop flutter speed {f(c['closed_loop_flutter_speed'], ' m/s')}; "
+                f"stable intervals {[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
+            )
+    else:
+        for k, v in s.items():
+            if k not in ("scenario", "kind"):
+                lines.append(f"  {k}: {v}")
+    for k, v in s.get("files", {}).items():
+        lines.append(f"  wrote {k}: {v}")
+    return "\n".join(lines)
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .fileio import save_figure
+    from .runs import load_result
+
+    res = load_result(args.result)
+    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
+    save_figure(res.plot(), out, dpi=120)
+    print(f"plot written to {out}")
     return 0
 
 
@@ -180,10 +313,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = _parser()
     args = parser.parse_args(argv)
-    handlers = {"flutter": _cmd_flutter, "modes": _cmd_modes, "examples": _cmd_examples}
+    handlers = {
+        "flutter": _cmd_flutter,
+        "modes": _cmd_modes,
+        "examples": _cmd_examples,
+        "run": _cmd_run,
+        "simulate": _cmd_run,
+        "trade": _cmd_run,
+        "plot": _cmd_plot,
+    }
     try:
         return handlers[args.command](args)
     except InputError as exc:
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # unwritable output folder, unreadable file
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2
     except (RuntimeError, ArithmeticError, __import__("numpy").linalg.LinAlgError) as exc:

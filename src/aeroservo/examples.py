@@ -105,3 +105,30 @@ def goland_aileron(
 
 BUILTIN_WINGS = {"goland": goland, "goland_aileron": goland_aileron}
 """Wings available by name on the command line and in scenario files."""
+
+
+def scenario_folder():
+    """The ``scenarios/`` folder shipped with the source tree (or ``./scenarios``), or None."""
+    from pathlib import Path
+
+    for folder in (Path(__file__).resolve().parents[2] / "scenarios", Path.cwd() / "scenarios"):
+        if folder.is_dir():
+            return folder
+    return None
+
+
+def shipped_scenarios() -> list:
+    """``(path, kind, name)`` of every scenario file in :func:`scenario_folder`."""
+    from .errors import InputError
+    from .tomlspec import read_toml
+
+    folder = scenario_folder()
+    out = []
+    for path in sorted(folder.glob("*.toml")) if folder else []:
+        try:
+            sc = read_toml(path).get("scenario")
+        except InputError:
+            continue
+        if isinstance(sc, dict):
+            out.append((path, str(sc.get("kind", "?")), str(sc.get("name", ""))))
+    return out

@@ -17,6 +17,10 @@ records ``fallback=True`` with the solver's status for that sample, and carries 
 
 from __future__ import annotations
 
+import contextlib
+import io
+import os
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -155,6 +159,37 @@ class MPCController:
         self.kf.predict(u)
 
 
+@contextlib.contextmanager
+def _c_stdout_silenced():
+    """Send what C code writes to the process's stdout to /dev/null for a moment, so that
+    machine-readable output on stdout (``--json``) is not corrupted."""
+    sys.stdout.flush()
+    fd = 1  # C code writes to file descriptor 1 whatever sys.stdout is
+    try:
+        saved = os.dup(fd)
+    except OSError:  # no stdout at all
+        with contextlib.redirect_stdout(io.StringIO()):
+            yield
+        return
+    try:
+        with open(os.devnull, "wb") as null, contextlib.redirect_stdout(io.StringIO()):
+            os.dup2(null.fileno(), fd)  # casadi prints through Python's sys.stdout, plugins
+            yield  # may print through C stdio: silence both
+            _flush_c_stdio()  # C stdio buffers output to a pipe: flush it into /dev/null
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+def _flush_c_stdio() -> None:
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # no C library to flush (not on this platform)
+        pass
+
+
 def _condensed(Phi, Gu, Q, R, N, P, horizon):
     """Matrices of the condensed QP: J = U'HU + 2 x0'G'U + const (G: (N m, n))."""
     n, m = Gu.shape
@@ -284,12 +319,13 @@ def mpc(
         rows.append(np.hstack([Tu_out, np.eye(ns)]))
     A_con = np.vstack(rows)
     H_full = 2.0 * Hs
-    conic = ca.conic(
-        "aeroservo_mpc",
-        solver,
-        {"h": ca.DM(H_full).sparsity(), "a": ca.DM(A_con).sparsity()},
-        SOLVERS[solver],
-    )
+    with _c_stdout_silenced():  # qpOASES prints a licence banner on stdout at creation
+        conic = ca.conic(
+            "aeroservo_mpc",
+            solver,
+            {"h": ca.DM(H_full).sparsity(), "a": ca.DM(A_con).sparsity()},
+            SOLVERS[solver],
+        )
     ctrl = MPCController(
         horizon=horizon,
         controls=tuple(controls),

@@ -34,10 +34,13 @@ class GainSchedule:
         Design speeds [m/s], increasing.
     controllers : list of StateFeedback or OutputFeedback
         One design per speed, all of the same kind and size.
+    design_speed : float
+        Reference speed [m/s] of the schedule's closed-loop boundary (optional).
     """
 
     speeds: np.ndarray
     controllers: list
+    design_speed: float = float("nan")
 
     def __post_init__(self) -> None:
         self.speeds = speeds_grid(self.speeds)

@@ -1,0 +1,313 @@
+"""Running scenarios: open-loop flutter, closed-loop simulation, trade study; result files.
+
+Every file is written atomically (:mod:`aeroservo.fileio`): an interrupted or failed run never
+leaves a half-written result. A simulation result is one ``.npz`` file (time histories and a
+JSON ``meta`` record with units, limits and the summary) that :func:`load_result` reads back
+for re-plotting, plus a ``.json`` summary and ``.png`` figures.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .fileio import atomic_write, atomic_write_text, save_figure
+from .scenario import Scenario
+
+__all__ = ["run_scenario", "run_flutter", "run_simulation", "save_result", "load_result"]
+
+
+def _progress_bar(total: float, desc: str, enabled: bool, unit: str = "m/s"):
+    """A tqdm bar advanced to an absolute position by the returned callback (or no-ops)."""
+    if not enabled:
+        return (lambda v: None), (lambda: None)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=round(total, 1), desc=desc, unit=unit, leave=False, dynamic_ncols=True)
+
+    def update(v: float) -> None:
+        bar.n = round(min(v, total), 1)
+        bar.refresh()
+
+    return update, bar.close
+
+
+def _dumps(obj) -> str:
+    def default(o):
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        return str(o)
+
+    return json.dumps(obj, indent=2, default=default)
+
+
+def run_flutter(scenario: Scenario, out_dir: Path | None = None, progress: bool = False) -> dict:
+    """Open-loop flutter and divergence of the scenario's wing; writes JSON and a V-g plot."""
+    from .stability import flutter_boundary
+
+    model = scenario.model()
+    update, close = _progress_bar(scenario.v_max or 300.0, "flutter sweep", progress)
+    try:
+        fr = flutter_boundary(model, scenario.density, v_max=scenario.v_max, progress=update)
+    finally:
+        close()
+    summary = {
+        "scenario": scenario.name,
+        "kind": "flutter",
+        "wing": scenario.wing.name,
+        "flutter_speed": fr.flutter_speed,
+        "flutter_frequency": fr.flutter_frequency,
+        "divergence_speed": fr.divergence_speed,
+        "n_states": fr.n_states,
+        "density": scenario.density,
+        "n_elements": model.n_elements,
+        "wagner": model.wagner.name,
+        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3"},
+    }
+    summary.update({k: v for k, v in fr.to_dict().items() if k not in summary})
+    if scenario.pk:
+        from .pk import pk_flutter
+
+        pk = pk_flutter(model, scenario.density, v_max=fr.v_max)
+        summary["pk_exact_theodorsen"] = {
+            "flutter_speed": pk.flutter_speed,
+            "flutter_frequency": pk.flutter_frequency,
+        }
+    if out_dir is not None:
+        files = {"summary": str(out_dir / f"{scenario.result}.json")}
+        if scenario.plots:
+            from .plots import plot_vg
+
+            title = f"{scenario.wing.name}: {model.n_elements} elements, {model.wagner.name}"
+            png = out_dir / f"{scenario.result}_vg.png"
+            save_figure(plot_vg(fr, title=title), png, dpi=120)
+            files["vg_plot"] = str(png)
+        summary["files"] = files
+        atomic_write_text(files["summary"], _dumps(summary))
+    return summary
+
+
+def _envelope_ratio(y: np.ndarray, frac: float = 0.2) -> float:
+    n = max(1, int(frac * y.size))
+    first = np.abs(y[:n]).max()
+    return float(np.abs(y[-n:]).max() / first) if first > 0 else float("nan")
+
+
+def run_simulation(
+    scenario: Scenario, out_dir: Path | None = None, progress: bool = False
+) -> tuple[object, dict]:
+    """Closed-loop time simulation of a ``simulate`` scenario.
+
+    Returns
+    -------
+    (SimulationResult, dict)
+        The time histories and a JSON-ready summary (speeds [m/s], peaks and RMS in the
+        signals' units, growth ratio of the response, closed-loop flutter speed if asked).
+    """
+    from .design import closed_loop_boundary
+    from .simulate import simulate
+    from .stability import flutter_boundary
+
+    if scenario.kind != "simulate":
+        raise InputError(f"{scenario.source}: scenario.kind = {scenario.kind!r}: not 'simulate'")
+    t0 = time.perf_counter()
+    model = scenario.model()
+    fr = flutter_boundary(model, scenario.density)
+    vf = fr.flutter_speed
+    if scenario.speed is not None:
+        speed = scenario.speed
+    elif vf is None:
+        raise ArithmeticError(
+            f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, but the "
+            f"wing has no flutter below {fr.v_max:.4g} m/s"
+        )
+    else:
+        speed = scenario.speed_factor * vf
+    loop = scenario.loop(model)
+    spec = scenario.controller
+    controller = loop.design_controller(spec, speed, scenario.sample_rate, vf)
+    plant = loop.plant(speed)
+    dist = scenario.disturbance
+    x0 = loop.initial_state(dist.initial_tip) if dist.initial_tip else None
+    noise = {k: np.sqrt(v) for k, v in scenario.sensor_noise.items()} or None
+    result = simulate(
+        plant,
+        controller.at(speed) if hasattr(controller, "at") else controller,
+        duration=scenario.duration,
+        x0=x0,
+        disturbance=dist.gust,
+        limits=spec.limits,
+        delay=scenario.delay,
+        sensor_noise=noise,
+        seed=scenario.seed,
+    )
+    summary: dict = {
+        "scenario": scenario.name,
+        "kind": "simulate",
+        "wing": scenario.wing.name,
+        "controller": spec.name,
+        "controller_type": spec.type,
+        "speed": speed,
+        "density": scenario.density,
+        "open_loop_flutter_speed": vf,
+        "open_loop_flutter_frequency": fr.flutter_frequency,
+        "speed_over_flutter_speed": None if vf is None else speed / vf,
+        "open_loop_unstable": bool(np.max(np.linalg.eigvals(np.asarray(plant.A)).real) > 0),
+        "duration": scenario.duration,
+        "sample_rate": scenario.sample_rate,
+        "n_plant_states": plant.nstates,
+        "signals": {},
+        "saturated_fraction": result.saturated_fraction(),
+        "units": dict(result.units),
+    }
+    for group in (result.outputs, result.applied):
+        for name, y in group.items():
+            summary["signals"][name] = {
+                "peak": float(np.abs(y).max()),
+                "rms": float(np.sqrt(np.mean(y**2))),
+                "growth": _envelope_ratio(y),
+            }
+    tip = next((n for n in result.outputs if n.startswith("tip_")), None)
+    if tip is not None:
+        g = summary["signals"][tip]["growth"]
+        summary["response"] = "decays" if g < 1 else "grows"
+    if result.status:
+        times = np.array([s["solve_time"] for s in result.status])
+        summary["mpc"] = {
+            "solve_time_median": float(np.median(times)),
+            "solve_time_p99": float(np.percentile(times, 99)),
+            "fallbacks": int(sum(s["fallback"] for s in result.status)),
+            "statuses": sorted({s["status"] for s in result.status}),
+        }
+    boundary = None
+    if scenario.closed_loop_boundary and spec.type in ("lqr", "lqg"):
+        v_top = scenario.v_max_factor * (vf or speed)
+        update, close = _progress_bar(v_top, "closed-loop sweep", progress)
+        try:
+            boundary = closed_loop_boundary(
+                loop.plant,
+                controller,
+                v_top,
+                n_grid=scenario.n_grid,
+                reference_speed=speed,
+                progress=update,
+            )
+        finally:
+            close()
+        summary["closed_loop"] = boundary.to_dict()
+        if vf is not None and boundary.flutter_speed is not None:
+            summary["closed_loop"]["flutter_speed_increase"] = boundary.flutter_speed / vf - 1
+    summary["wall_time"] = time.perf_counter() - t0
+    if out_dir is not None:
+        files = {"result": str(out_dir / f"{scenario.result}.npz")}
+        save_result(result, files["result"], summary)
+        if scenario.plots:
+            png = out_dir / f"{scenario.result}.png"
+            save_figure(result.plot(), png, dpi=120)
+            files["plot"] = str(png)
+            if boundary is not None:
+                png = out_dir / f"{scenario.result}_boundary.png"
+                save_figure(boundary.plot(open_loop=fr), png, dpi=120)
+                files["boundary_plot"] = str(png)
+        files["summary"] = str(out_dir / f"{scenario.result}.json")
+        summary["files"] = files
+        atomic_write_text(files["summary"], _dumps(summary))
+    return result, summary
+
+
+def save_result(result, path: str | Path, summary: dict | None = None) -> Path:
+    """Write a simulation result to ``.npz`` (atomically)."""
+    arrays = {"t": result.t}
+    for group in ("outputs", "commands", "applied", "disturbance"):
+        for name, y in getattr(result, group).items():
+            arrays[f"{group}.{name}"] = np.asarray(y)
+    meta = {
+        "units": result.units,
+        "speed": result.speed,
+        "density": result.density,
+        "limits": {"magnitude": result.limits.magnitude, "rate": result.limits.rate},
+        "summary": summary or {},
+        "format": "aeroservo-simulation-1",
+    }
+    arrays["meta"] = np.array(_dumps(meta))
+
+    def write(p: Path) -> None:
+        with open(p, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    return atomic_write(path, write)
+
+
+def load_result(path: str | Path):
+    """Read a result written by :func:`save_result` back into a ``SimulationResult``."""
+    from .design.plant import Limits
+    from .simulate import SimulationResult
+
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            groups: dict = {"outputs": {}, "commands": {}, "applied": {}, "disturbance": {}}
+            for key in data.files:
+                if "." in key:
+                    g, name = key.split(".", 1)
+                    if g in groups:
+                        groups[g][name] = data[key]
+            t = data["t"]
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such result file") from None
+    except (OSError, ValueError, KeyError) as exc:
+        raise InputError(f"{path}: not an aeroservo simulation result ({exc})") from None
+    if meta.get("format") != "aeroservo-simulation-1":
+        raise InputError(
+            f"{path}: not an aeroservo simulation result (format {meta.get('format')})"
+        )
+    res = SimulationResult(
+        t=t,
+        status=[],
+        limits=Limits(**meta["limits"]),
+        units=meta["units"],
+        speed=meta["speed"],
+        density=meta["density"],
+        **groups,
+    )
+    res.summary = meta.get("summary", {})
+    return res
+
+
+def run_scenario(
+    scenario: Scenario,
+    out_dir: Path | None,
+    *,
+    progress: bool = False,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    log: Callable[[str], None] | None = None,
+) -> dict:
+    """Run any scenario; returns its JSON-ready summary."""
+    if scenario.kind == "flutter":
+        return run_flutter(scenario, out_dir, progress)
+    if scenario.kind == "simulate":
+        return run_simulation(scenario, out_dir, progress)[1]
+    from .trade import run_trade, study_from_scenario
+
+    study = study_from_scenario(scenario)
+    if out_dir is None:
+        raise InputError("a trade study needs an output folder (--out)")
+    res = run_trade(
+        study,
+        out_dir / scenario.result,
+        scheduler=scheduler,
+        n_workers=workers or scenario.trade["workers"],
+        progress=progress,
+    )
+    summary = res.summary() if hasattr(res, "summary") else {}
+    summary.update({"scenario": scenario.name, "kind": "trade"})
+    return summary
