@@ -20,7 +20,8 @@ demo: install
 	mkdir -p out
 	$(BIN)/aeroservo flutter goland --pk --plot out/goland_vg.png
 	$(BIN)/aeroservo flutter scenarios/goland_aileron.toml --json > out/goland_aileron_flutter.json
-	@echo "wrote out/goland_vg.png and out/goland_aileron_flutter.json"
+	$(BIN)/aeroservo simulate scenarios/goland_aileron_lqr.toml --out out
+	@echo "wrote out/goland_vg.png, out/goland_aileron_flutter.json and out/goland_aileron_lqr.*"
 
 lint: install
 	$(BIN)/ruff check src tests bench
@@ -32,6 +33,8 @@ test: lint
 bench: install
 	$(BIN)/python bench/bench_flutter.py
 	$(BIN)/python bench/bench_statespace.py
+	$(BIN)/python bench/bench_control.py
+	$(BIN)/python bench/bench_trade.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .ruff_cache

@@ -288,9 +288,21 @@ def _readable(s: dict) -> str:
                 f"stable intervals {[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
             )
     else:
-        for k, v in s.items():
-            if k not in ("scenario", "kind"):
-                lines.append(f"  {k}: {v}")
+        lines.append(
+            f"  {s['n_cases']} cases ({s['n_skipped']} already done, {s['n_failed']} failed) in "
+            f"{s['elapsed']:.1f} s, {s['cases_per_second']:.2f} cases/s"
+        )
+        b = s.get("best_case")
+        if b:
+            from .trade import PARAMETERS
+
+            params = ", ".join(f"{k} = {b[k]:g}" for k in PARAMETERS if k in b)
+            lines.append(
+                f"  best suppression margin {b['suppression_margin']:+.1%} ({params}): "
+                f"open loop {f(b['open_loop_flutter_speed'], ' m/s')}, closed loop "
+                f"{f(b.get('closed_loop_flutter_speed'), ' m/s')}, peak hinge moment "
+                f"{f(b.get('hinge_moment_peak'), ' N m')} in the gust"
+            )
     for k, v in s.get("files", {}).items():
         lines.append(f"  wrote {k}: {v}")
     return "\n".join(lines)

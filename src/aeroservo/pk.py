@@ -207,7 +207,7 @@ def pk_flutter(
                     raise PKConvergenceError("the p-k root jumped to another solution")
             except PKConvergenceError:
                 # no consistent p-k root: the branch ends here (typically a heavily damped one)
-                P[i:, j] = np.nan
+                P[i:, j] = complex(np.nan, np.nan)  # NaN frequency and damping
                 ended[f"mode {j + 1}"] = float(speeds[i])
                 break
 

@@ -296,18 +296,71 @@ def run_scenario(
         return run_flutter(scenario, out_dir, progress)
     if scenario.kind == "simulate":
         return run_simulation(scenario, out_dir, progress)[1]
-    from .trade import run_trade, study_from_scenario
+    from .trade import run_trade
 
-    study = study_from_scenario(scenario)
     if out_dir is None:
         raise InputError("a trade study needs an output folder (--out)")
+    folder = out_dir / scenario.result
     res = run_trade(
-        study,
-        out_dir / scenario.result,
+        study_from_scenario(scenario),
+        folder,
         scheduler=scheduler,
         n_workers=workers or scenario.trade["workers"],
         progress=progress,
     )
-    summary = res.summary() if hasattr(res, "summary") else {}
-    summary.update({"scenario": scenario.name, "kind": "trade"})
+    summary = {
+        "scenario": scenario.name,
+        "kind": "trade",
+        "n_cases": res.n_cases,
+        "n_failed": res.n_failed,
+        "n_skipped": res.n_skipped,
+        "elapsed": res.elapsed,
+        "cases_per_second": (res.n_cases - res.n_skipped) / max(res.elapsed, 1e-9),
+    }
+    ok = res.table[res.table["status"] == "ok"]
+    if len(ok):
+        best = ok.loc[ok["suppression_margin"].idxmax()]
+        summary["best_case"] = {
+            k: (v.item() if hasattr(v, "item") else v) for k, v in best.items() if v == v
+        }
+    files = {"csv": str(res.csv_path), "netcdf": str(res.netcdf_path)}
+    if scenario.plots and len(ok):
+        names = list(res.parameters)
+        if len(names) >= 2:
+            png = folder / "heatmap.png"
+            save_figure(res.heatmap("suppression_margin", names[0], names[1]), png, dpi=120)
+            files["heatmap"] = str(png)
+        png = folder / "pareto.png"
+        save_figure(res.pareto(), png, dpi=120)
+        files["pareto"] = str(png)
+    summary["files"] = files
+    atomic_write_text(folder / "summary.json", _dumps(summary))
     return summary
+
+
+def study_from_scenario(scenario: Scenario):
+    """The :class:`~aeroservo.trade.TradeStudy` of a ``trade`` scenario."""
+    from .trade import TradeStudy
+
+    t = scenario.trade
+    return TradeStudy(
+        base_wing=scenario.wing,
+        density=scenario.density,
+        elements=scenario.elements,
+        wagner=scenario.wagner,
+        controls=tuple(scenario.controls),
+        sensors=tuple(scenario.sensors),
+        outputs=tuple(scenario.outputs),
+        design_modes=scenario.design_modes,
+        sensor_filter=scenario.sensor_filter,
+        controller=t["controller"],
+        sample_rate=scenario.sample_rate,
+        parameters=dict(t["parameters"]),
+        speed_factor=t["speed_factor"],
+        gust_length=t["gust_length"],
+        gust_amplitude=t["gust_amplitude"],
+        gust_duration=t["gust_duration"],
+        v_max_factor=t["v_max_factor"],
+        n_grid=t["n_grid"],
+        name=scenario.result,
+    )

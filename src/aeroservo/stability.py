@@ -102,7 +102,8 @@ class FlutterResult:
     def damping_ratio(self) -> np.ndarray:
         """-Re(lambda)/|lambda| [-] (positive: stable)."""
         mag = np.abs(self.eigenvalues)
-        return np.divide(-self.eigenvalues.real, mag, out=np.zeros_like(mag), where=mag > 0)
+        out = np.where(np.isnan(mag), np.nan, 0.0)  # NaN where a branch has ended (p-k)
+        return np.divide(-self.eigenvalues.real, mag, out=out, where=mag > 0)
 
     @property
     def flutter(self) -> Crossing | None:
