@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .design.mpc import SOLVERS
 from .design.plant import Limits
-from .tomlspec import Table, read_toml
+from .tomlspec import Table, check_integers, one_line_errors, read_toml
 
 __all__ = ["ControllerSpec", "load_controller", "controller_from_dict", "CONTROLLER_TYPES"]
 
@@ -90,6 +90,12 @@ TOP_KEYS = ("type", "name", "description", "weights", "limits", "estimator", "mp
 
 def controller_from_dict(data: object, file: str = "<dict>") -> ControllerSpec:
     """Build a :class:`ControllerSpec` from a parsed controller file."""
+    with one_line_errors():
+        return _controller_from_dict(data, file)
+
+
+def _controller_from_dict(data: object, file: str) -> ControllerSpec:
+    check_integers(data, file)
     top = Table(data, "", file).check_keys(("type",), TOP_KEYS[1:])
     kind = top.string("type", choices=CONTROLLER_TYPES, required=True)
     top.string("description")
@@ -166,4 +172,5 @@ def raise_missing(table: Table, key: str, kind: str):
 
 def load_controller(path: str | Path) -> ControllerSpec:
     """Read a controller file (``controllers/*.toml``)."""
-    return controller_from_dict(read_toml(path), str(path))
+    with one_line_errors():
+        return controller_from_dict(read_toml(path), str(path))

@@ -35,7 +35,7 @@ from .errors import InputError, check_int, check_number
 from .simulate import tip_deflection_state
 from .statespace import StateSpaceBuilder
 
-__all__ = ["ControlLoop"]
+__all__ = ["ControlLoop", "check_spec_signals"]
 
 
 class ControlLoop:
@@ -139,34 +139,7 @@ class ControlLoop:
 
     def check_spec(self, spec: ControllerSpec) -> None:
         """Every signal of a spec must be a control, a sensor or an output of this loop."""
-        allowed = {
-            "weights.outputs": self.outputs,
-            "weights.inputs": self.controls,
-            "limits.magnitude": self.controls,
-            "limits.rate": self.controls,
-            "estimator.process_noise": ["gust"],
-            "estimator.sensor_noise": self.sensors,
-            "mpc.soft_outputs": self.outputs,
-        }
-        for key, names in spec.signals.items():
-            for n in names:
-                if n not in allowed[key]:
-                    raise InputError(
-                        f"{spec.source}: {key}.{n}: not a signal of this loop; allowed "
-                        f"{allowed[key]}"
-                    )
-        if spec.type in ("lqr", "lqg", "mpc"):
-            missing = [c for c in self.controls if c not in spec.bryson_inputs]
-            if missing:
-                raise InputError(
-                    f"{spec.source}: weights.inputs: give an allowed value for {missing}"
-                )
-        if spec.type in ("lqg", "mpc"):
-            missing = [s for s in self.sensors if s not in spec.sensor_noise]
-            if missing:
-                raise InputError(
-                    f"{spec.source}: estimator.sensor_noise: give a variance for {missing}"
-                )
+        check_spec_signals(spec, self.controls, self.sensors, self.outputs)
 
     def design_controller(
         self,
@@ -238,3 +211,41 @@ class ControlLoop:
         ctrl: GainSchedule = schedule(one, [f * flutter_speed for f in spec.schedule])
         ctrl.design_speed = speed
         return ctrl
+
+
+def check_spec_signals(
+    spec: ControllerSpec, controls: Sequence[str], sensors: Sequence[str], outputs: Sequence[str]
+) -> None:
+    """Check a controller spec's signal names against a loop's controls, sensors and outputs.
+
+    Raises
+    ------
+    InputError
+        Naming the spec's file, the key and the signal.
+    """
+    outputs = list(dict.fromkeys(list(sensors) + list(outputs)))
+    allowed = {
+        "weights.outputs": outputs,
+        "weights.inputs": list(controls),
+        "limits.magnitude": list(controls),
+        "limits.rate": list(controls),
+        "estimator.process_noise": ["gust"],
+        "estimator.sensor_noise": list(sensors),
+        "mpc.soft_outputs": outputs,
+    }
+    for key, names in spec.signals.items():
+        for n in names:
+            if n not in allowed[key]:
+                raise InputError(
+                    f"{spec.source}: {key}.{n}: not a signal of this loop; allowed {allowed[key]}"
+                )
+    if spec.type in ("lqr", "lqg", "mpc"):
+        missing = [c for c in controls if c not in spec.bryson_inputs]
+        if missing:
+            raise InputError(f"{spec.source}: weights.inputs: give an allowed value for {missing}")
+    if spec.type in ("lqg", "mpc"):
+        missing = [s for s in sensors if s not in spec.sensor_noise]
+        if missing:
+            raise InputError(
+                f"{spec.source}: estimator.sensor_noise: give a variance for {missing}"
+            )

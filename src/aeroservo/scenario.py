@@ -18,7 +18,7 @@ import numpy as np
 
 from .controller_spec import ControllerSpec, load_controller
 from .errors import InputError
-from .tomlspec import Table, read_toml
+from .tomlspec import Table, check_integers, one_line_errors, read_toml
 
 __all__ = ["Scenario", "Disturbance", "load_scenario", "scenario_from_dict", "SCENARIO_KINDS"]
 
@@ -169,21 +169,18 @@ def _wing(tbl: Table, base: Path):
         path = tbl.path("file", base)
         if not _is_file(path):
             tbl.fail("file", tbl.data["file"], f"no such wing file ({path})")
+        data = None
         try:
+            data = read_toml(path).get("wing")
             return load_wing(path)[0], str(path)
         except InputError as exc:
-            try:
-                data = read_toml(path).get("wing")
-            except InputError:
-                data = None
             msg = _surface_keys(str(exc), data, "wing")
             raise InputError(f"{tbl.file}: {tbl.key_name('file')} -> {msg}") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            tbl.fail("file", tbl.data["file"], f"cannot read the wing file: {exc}")
     try:
         return wing_from_dict(tbl.data, tbl.where), "inline"
     except InputError as exc:
-        raise InputError(f"{tbl.file}: {_surface_keys(str(exc), tbl.data, tbl.where)}") from None
+        msg = _surface_keys(str(exc), tbl.data, tbl.where)
+        raise InputError(f"{tbl.file}: {msg}") from None
 
 
 def _disturbance(tbl: Table, base: Path, span: float) -> Disturbance:
@@ -244,9 +241,16 @@ def _gust_series(tbl: Table, path: Path, cls):
 
 def scenario_from_dict(data: object, file: str = "<dict>", base: Path | None = None) -> Scenario:
     """Validate a parsed scenario file. ``base`` is the folder relative paths start from."""
+    with one_line_errors():
+        return _scenario_from_dict(data, file, base)
+
+
+def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
+    from .mesh import build_mesh
     from .wagner import wagner_set
 
     base = Path(file).parent if base is None else base
+    check_integers(data, file)
     top = Table(data, "", file).check_keys(("scenario", "wing"), TOP[2:])
     sc = top.table("scenario").check_keys(("name", "kind"), ("description",))
     kind = sc.string("kind", choices=SCENARIO_KINDS, required=True)
@@ -275,6 +279,10 @@ def scenario_from_dict(data: object, file: str = "<dict>", base: Path | None = N
         (), ("elements", "wagner", "design_modes", "gust", "v_max", "pk")
     )
     kw["elements"] = md.integer("elements", 10, lo=1, hi=400)
+    try:
+        build_mesh(wing, kw["elements"])
+    except InputError as exc:  # too few elements for the wing's breakpoints
+        md.fail("elements", kw["elements"], str(exc).split(": ", 1)[-1])
     if md.has("wagner"):
         try:
             wagner_set(md.data["wagner"])
@@ -316,7 +324,8 @@ def scenario_from_dict(data: object, file: str = "<dict>", base: Path | None = N
     out = top.table("output").check_keys((), ("result", "plots"))
     stem = Path(file).stem if file != "<dict>" else "scenario"
     kw["result"] = out.string("result", stem)
-    if not kw["result"] or Path(kw["result"]).name != kw["result"]:
+    result = kw["result"]
+    if result in ("", ".", "..") or Path(result).name != result or not result.isprintable():
         out.fail("result", kw["result"], "expected a plain file name stem (no folders)")
     kw["plots"] = out.boolean("plots", True)
 
@@ -392,6 +401,7 @@ def _trade_table(tbl: Table, base: Path) -> dict:
 
 def _cross_check(s: Scenario, top: Table) -> None:
     """Checks that need the wing: signal names, stations, limits against the initial state."""
+    from .loop import check_spec_signals
     from .signals import input_names, resolve_outputs
 
     if s.kind == "flutter":
@@ -418,27 +428,6 @@ def _cross_check(s: Scenario, top: Table) -> None:
                 resolve_outputs(model, [name], model.n_dofs)
             except InputError as exc:
                 sg.fail(key, names, str(exc))
-    try:
-        loop = s.loop(model)
-    except InputError as exc:
-        raise InputError(f"{s.source}: signals: {exc}") from None
-    if s.kind == "trade":
-        try:
-            loop.check_spec(s.trade["controller"])
-        except InputError as exc:
-            raise InputError(f"{s.source}: trade.controller -> {exc}") from None
-    if s.kind != "simulate":
-        return
-    spec = s.controller
-    try:
-        loop.check_spec(spec)
-    except InputError as exc:
-        raise InputError(f"{s.source}: controller.spec -> {exc}") from None
-    for name in s.sensor_noise:
-        if name not in s.sensors:
-            top.table("simulation").table("sensor_noise").fail(
-                name, s.sensor_noise[name], f"not a sensor; sensors are {list(s.sensors)}"
-            )
     if s.sensor_filter is not None and s.sensor_filter >= 0.5 * s.sample_rate:
         sg.fail(
             "sensor_filter",
@@ -446,8 +435,33 @@ def _cross_check(s: Scenario, top: Table) -> None:
             f"must be below the Nyquist frequency {0.5 * s.sample_rate:g} Hz of "
             "simulation.sample_rate",
         )
+    # the controller's signal names against the loop's, without building the loop's
+    # state-space models (that takes minutes for a fine mesh)
+    key = "trade.controller" if s.kind == "trade" else "controller.spec"
+    spec = s.trade["controller"] if s.kind == "trade" else s.controller
+    try:
+        check_spec_signals(spec, s.controls, s.sensors, s.outputs)
+    except InputError as exc:
+        raise InputError(f"{s.source}: {key} -> {exc}") from None
+    if s.kind == "trade":
+        from .runs import study_from_scenario
+
+        try:
+            study_from_scenario(s)  # validates the study (parameters against the wing, ...)
+        except InputError as exc:
+            raise InputError(f"{s.source}: trade: {exc}") from None
+        return
+    for name in s.sensor_noise:
+        if name not in s.sensors:
+            top.table("simulation").table("sensor_noise").fail(
+                name, s.sensor_noise[name], f"not a sensor; sensors are {list(s.sensors)}"
+            )
     # soft output limits the initial state already violates
     if spec.type == "mpc" and spec.soft_outputs and s.disturbance.initial_tip:
+        try:
+            loop = s.loop(model)
+        except InputError as exc:
+            raise InputError(f"{s.source}: signals: {exc}") from None
         x0 = loop.initial_state(s.disturbance.initial_tip)
         y0 = np.asarray(loop.plant_builder.at(0.0).C) @ x0[: loop.plant_builder.n_states]
         for name, lim in spec.soft_outputs.items():
@@ -486,7 +500,8 @@ def load_scenario(path: str | Path) -> Scenario:
         With the file, the key and the value of the first problem found.
     """
     path = Path(path)
-    return scenario_from_dict(read_toml(path), str(path), path.parent)
+    with one_line_errors():
+        return scenario_from_dict(read_toml(path), str(path), path.parent)
 
 
 def is_scenario_file(path: str | Path) -> bool:

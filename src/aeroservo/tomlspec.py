@@ -11,12 +11,34 @@ import json
 import math
 import re
 import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import InputError
 
-__all__ = ["Table", "read_toml"]
+__all__ = ["Table", "read_toml", "check_integers", "one_line", "one_line_errors"]
+
+INT64 = (-(2**63), 2**63 - 1)
+"""Range of TOML integers (tomllib reads integers of any size)."""
+
+
+def one_line(message: str) -> str:
+    """Escape line breaks and other unprintable characters (from keys, values or file names
+    quoted as they are): an error message is one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+
+
+@contextmanager
+def one_line_errors() -> Iterator[None]:
+    """Re-raise an :class:`InputError` whose message spans several lines as a one-line one."""
+    try:
+        yield
+    except InputError as exc:
+        message = one_line(str(exc))
+        if message == str(exc):
+            raise
+        raise InputError(message) from None
 
 
 def read_toml(path: str | Path) -> dict:
@@ -24,17 +46,41 @@ def read_toml(path: str | Path) -> dict:
     path = Path(path)
     try:
         with path.open("rb") as fh:
-            return tomllib.load(fh)
+            raw = fh.read()
     except FileNotFoundError:
         raise InputError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise InputError(f"{path}: is a folder, expected a TOML file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except (OSError, ValueError) as exc:  # unreadable, name too long, embedded NUL, ...
+        raise InputError(f"{path}: cannot read the file: {exc}") from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a UTF-8 text file") from None
-    except (OSError, ValueError) as exc:  # unreadable, name too long, embedded NUL, ...
-        raise InputError(f"{path}: cannot read: {exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except ValueError as exc:  # an integer literal of more than 4300 digits
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
+    check_integers(data, str(path))
+    return data
+
+
+def check_integers(data: object, file: str, where: str = "") -> None:
+    """Reject integers outside the 64-bit range of TOML, by key path."""
+    if isinstance(data, Mapping):
+        for k, v in data.items():
+            check_integers(v, file, f"{where}.{_key(k)}" if where else _key(k))
+    elif isinstance(data, list):
+        for i, v in enumerate(data):
+            check_integers(v, file, f"{where}[{i}]")
+    elif isinstance(data, int) and not isinstance(data, bool):
+        if not INT64[0] <= data <= INT64[1]:
+            raise InputError(
+                f"{file}: {where or '(top level)'} = {_show(data)}: integer outside the 64-bit "
+                f"range of TOML [{INT64[0]}, {INT64[1]}]"
+            )
 
 
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+(\[\d+\])?")
@@ -48,7 +94,10 @@ def _key(key: object) -> str:
 
 
 def _show(value: object) -> str:
-    text = repr(value)
+    try:
+        text = repr(value)
+    except ValueError:  # an integer too long to print
+        text = f"<{type(value).__name__} too long to show>"
     return text if len(text) <= 80 else text[:77] + "..."
 
 
