@@ -12,6 +12,7 @@ import json
 import sys
 from collections.abc import Sequence
 
+from ._threads import blas_limited
 from .errors import InputError
 
 __all__ = ["main"]
@@ -321,6 +322,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+@blas_limited
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = _parser()

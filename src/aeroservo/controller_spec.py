@@ -65,7 +65,7 @@ class ControllerSpec:
     process_noise: dict = field(default_factory=dict)
     sensor_noise: dict = field(default_factory=dict)
     horizon: int = 20
-    solver: str = "qpoases"
+    solver: str = "daqp"
     soft_outputs: dict = field(default_factory=dict)
     slack_weight: float = 1e4
     schedule: tuple | None = None
@@ -150,7 +150,7 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
 
     m = top.table("mpc").check_keys((), ("horizon", "solver", "soft_outputs", "slack_weight"))
     kw["horizon"] = m.integer("horizon", 20, lo=1, hi=500)
-    kw["solver"] = m.string("solver", "qpoases", choices=sorted(SOLVERS))
+    kw["solver"] = m.string("solver", "daqp", choices=sorted(SOLVERS))
     kw["soft_outputs"] = m.number_map("soft_outputs")
     kw["slack_weight"] = m.number("slack_weight", 1e4, lo=0.0, lo_open=True)
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from ._threads import blas_limited
 from .errors import check_int, check_number
 from .stability import Crossing, FlutterResult
 from .system import AeroMatrices
@@ -147,6 +148,7 @@ def static_divergence_speed(am: AeroMatrices, density: float) -> float | None:
     return None if mu.size == 0 else float(1.0 / np.sqrt(density * mu.max()))
 
 
+@blas_limited
 def pk_flutter(
     model: object,
     density: float,

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._threads import blas_limited
 from .errors import InputError
 from .fileio import atomic_write, atomic_write_text, save_figure
 from .scenario import Scenario
@@ -48,6 +49,7 @@ def _dumps(obj) -> str:
     return json.dumps(obj, indent=2, default=default)
 
 
+@blas_limited
 def run_flutter(scenario: Scenario, out_dir: Path | None = None, progress: bool = False) -> dict:
     """Open-loop flutter and divergence of the scenario's wing; writes JSON and a V-g plot."""
     from .stability import flutter_boundary
@@ -100,6 +102,7 @@ def _envelope_ratio(y: np.ndarray, frac: float = 0.2) -> float:
     return float(np.abs(y[-n:]).max() / first) if first > 0 else float("nan")
 
 
+@blas_limited
 def run_simulation(
     scenario: Scenario, out_dir: Path | None = None, progress: bool = False
 ) -> tuple[object, dict]:
@@ -282,6 +285,7 @@ def load_result(path: str | Path):
     return res
 
 
+@blas_limited
 def run_scenario(
     scenario: Scenario,
     out_dir: Path | None,

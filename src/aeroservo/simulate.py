@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._threads import blas_limited
 from .design.plant import Limits, SampledPlant
 from .errors import InputError, check_int, check_number
 
@@ -43,6 +44,9 @@ class SimulationResult:
     speed, density : float
     states : ndarray (n, n_states) or None
         Plant states, if recorded.
+    wall_time : float
+        Wall time of the time marching and output evaluation [s] (the discretization of the
+        plant before it is not included).
     """
 
     t: np.ndarray
@@ -77,39 +81,55 @@ class SimulationResult:
     def plot(
         self, tip: str | None = None, control: str | None = None, deflection: str | None = None
     ):
-        """Tip response, control input with its limits, and surface deflection (Figure)."""
+        """Gust (if any), tip response, control input with its limits and commanded values,
+        and surface deflection, against time (matplotlib Figure).
+
+        Parameters
+        ----------
+        tip, control, deflection : str, optional
+            Signals to show (defaults: ``tip_disp`` or the first ``tip_*`` output, the first
+            control, the first ``*_deflection`` output).
+        """
         from matplotlib.figure import Figure
 
         tip = tip or next(
-            (n for n in self.outputs if n.startswith("tip_")), next(iter(self.outputs))
+            (n for n in ("tip_disp", *self.outputs) if n in self.outputs and n.startswith("tip")),
+            next(iter(self.outputs)),
         )
         control = control or next(iter(self.applied))
         deflection = deflection or next(
             (n for n in self.outputs if n.endswith("_deflection")), None
         )
-        rows = 3 if deflection else 2
-        fig = Figure(layout="constrained", figsize=(7.5, 2.3 * rows))
-        axes = fig.subplots(rows, 1, sharex=True)
-        axes[0].plot(self.t, self.outputs[tip])
-        axes[0].set_ylabel(f"{tip} [{self.units.get(tip, '')}]")
-        axes[1].plot(self.t, self.applied[control], label="applied")
-        axes[1].plot(self.t, self.commands[control], "--", lw=0.8, label="commanded")
-        mag = self.limits.magnitude.get(control)
-        if mag is not None:
-            for s in (-1, 1):
-                axes[1].axhline(s * mag, color="r", lw=0.8, ls=":")
-        axes[1].set_ylabel(f"{control} [{self.units.get(control, '')}]")
-        axes[1].legend(fontsize=8)
-        if deflection:
-            axes[2].plot(self.t, np.degrees(self.outputs[deflection]))
-            axes[2].set_ylabel(f"{deflection} [deg]")
-        axes[-1].set_xlabel("time [s]")
-        for ax in axes:
+        panels = [g for g in self.disturbance if np.any(self.disturbance[g])] + [tip, control]
+        panels += [deflection] if deflection else []
+        fig = Figure(layout="constrained", figsize=(7.5, 2.1 * len(panels)))
+        axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
+        for ax, name in zip(axes, panels, strict=True):
+            unit = self.units.get(name, "")
+            if name == control:
+                ax.plot(self.t, self.applied[name], label="applied")
+                ax.plot(self.t, self.commands[name], "--", lw=0.8, label="commanded")
+                mag = self.limits.magnitude.get(name)
+                if mag is not None:
+                    for sgn in (-1, 1):
+                        ax.axhline(sgn * mag, color="r", lw=0.8, ls=":")
+                ax.legend(fontsize=8)
+            elif name == deflection:
+                ax.plot(self.t, np.degrees(self.outputs[name]))
+                unit = "deg"
+            elif name in self.disturbance:
+                ax.plot(self.t, self.disturbance[name], color="0.4")
+                unit = unit or "m/s"
+            else:
+                ax.plot(self.t, self.outputs[name])
+            ax.set_ylabel(f"{name} [{unit}]")
             ax.grid(True, alpha=0.3)
+        axes[-1].set_xlabel("time [s]")
         fig.suptitle(f"closed loop at {self.speed:.4g} m/s")
         return fig
 
 
+@blas_limited
 def simulate(
     plant,
     controller,
@@ -131,10 +151,9 @@ def simulate(
     plant : control.StateSpace
         Continuous plant with the controller's control inputs (and ``"gust"`` if a gust
         disturbance is given) and the controller's sensors among its outputs.
-    controller : StateFeedback, OutputFeedback, MPCController or None
-        Sampled controller (its ``dt`` sets the sample period); None runs the open loop
-        (then give ``dt`` through ``plant`` with a controller-free call: use
-        :class:`aeroservo.design.OpenLoop`).
+    controller : StateFeedback, OutputFeedback, GainSchedule, MPCController or OpenLoop
+        Sampled controller (its ``dt`` sets the sample period); a gain schedule is evaluated
+        at the plant's speed; :class:`aeroservo.design.OpenLoop` runs the open loop.
     duration : float
         [s].
     x0 : ndarray, optional
@@ -159,6 +178,8 @@ def simulate(
     -------
     SimulationResult
     """
+    if hasattr(controller, "at"):  # a gain schedule: the controller at the plant's speed
+        controller = controller.at(float(getattr(plant, "speed", np.nan)))
     dt = check_number("controller.dt", controller.dt, unit="s", lo=0.0, lo_open=True)
     duration = check_number("duration", duration, unit="s", lo=0.0, lo_open=True)
     check_int("seed", seed, lo=0)
@@ -181,56 +202,39 @@ def simulate(
     if x.shape != (sp.n_states,):
         raise InputError(f"x0: expected {sp.n_states} states, got shape {x.shape}")
     mag, rate = limits.arrays(controls)
-    m = len(controls)
     s_idx = [out_names.index(s) for s in sensors]
-    noise = np.zeros((n_steps + 1, len(sensors)))
+    rec_idx = [i for i, n in enumerate(out_names) if n in rec]
+    noise = None
     if sensor_noise:
         rng = np.random.default_rng(seed)
         sd = np.array([sensor_noise.get(s, 0.0) for s in sensors])
-        noise = rng.standard_normal(noise.shape) * sd
+        noise = rng.standard_normal((n_steps + 1, len(sensors))) * sd
 
-    Phi, Gu, Gd, C, Du, Dd = sp.Phi, sp.Gu, sp.Gd, sp.C, sp.Du, sp.Dd
-    Y = np.empty((n_steps + 1, len(out_names)))
-    U = np.empty((n_steps + 1, m))
-    Cmd = np.empty((n_steps + 1, m))
-    X = np.empty((n_steps + 1, sp.n_states)) if record_states else None
-    status: list = []
-    h = np.zeros(m)  # command held over the previous interval
-    pending = np.zeros(m)
     controller.reset()
     fixed_gain = (
         getattr(controller, "gain", None) if getattr(controller, "needs_state", False) else None
     )
-    rate_dt = rate * dt
     t0 = time.perf_counter()
-    for k in range(n_steps + 1):
-        y = C @ x + Du @ h + Dd @ d[k]
-        Y[k] = y
-        if X is not None:
-            X[k] = x
-        if fixed_gain is not None:
-            c = -(fixed_gain @ x)
-        else:
-            ys = y[s_idx] + noise[k]
-            c = controller.command(ys, x)
-        if delay:
-            c, pending = pending, c
-        u = np.minimum(np.maximum(c, h - rate_dt), h + rate_dt)
-        u = np.minimum(np.maximum(u, -mag), mag)
-        if fixed_gain is None:
-            controller.update(ys, u)
-            st = getattr(controller, "last_status", None)
-            if st is not None:
-                status.append(st)
-        Cmd[k] = c
-        U[k] = u
-        x = Phi @ x + Gu @ u + Gd @ d[k]
-        h = u
+    Y, X, U, Cmd, status = _march(
+        sp,
+        controller,
+        fixed_gain,
+        x,
+        d,
+        noise,
+        s_idx,
+        rec_idx,
+        mag,
+        rate * dt,
+        delay,
+        n_steps,
+        record_states,
+    )
     wall = time.perf_counter() - t0
     units = dict(getattr(plant, "signal_units", {}))
     return SimulationResult(
         t=t,
-        outputs={n: Y[:, i] for i, n in enumerate(out_names) if n in rec},
+        outputs={out_names[i]: Y[:, j] for j, i in enumerate(rec_idx)},
         commands={c: Cmd[:, i] for i, c in enumerate(controls)},
         applied={c: U[:, i] for i, c in enumerate(controls)},
         disturbance={n: d[:, i] for i, n in enumerate(dist)},
@@ -242,6 +246,163 @@ def simulate(
         states=X,
         wall_time=wall,
     )
+
+
+_BLOCK = 1024
+"""Samples marched per block: the working array stays in cache whatever the duration."""
+
+
+def _rows_times(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``A @ B.T`` for a long ``A``, by ``np.einsum`` (no BLAS threads started: waking a
+    multithreaded BLAS pool costs more than these products, and its spinning workers then slow
+    the single-threaded loop that follows)."""
+    return np.einsum("ij,kj->ik", A, B)
+
+
+def _march(
+    sp,
+    controller,
+    fixed_gain,
+    x0,
+    d,
+    noise,
+    s_idx,
+    rec_idx,
+    mag,
+    rate_dt,
+    delay,
+    n_steps,
+    record_states,
+):
+    """The sampled loop: ``(outputs, states or None, applied, commands, status)`` per sample.
+
+    Each row of the working array ``Z`` is ``[x_k, s_k, u_k, d_k]``, where ``s_k`` is what the
+    controller reads: ``gain x_k`` (state feedback ``c = -gain x``) or the sensors without
+    their disturbance feedthrough and noise (``C_s x_k + Du_s u_{k-1}``). One matrix-vector
+    product per sample gives both ``x_{k+1}`` and ``s_{k+1}`` from row k. With one control the
+    limits are applied on Python floats (the same comparisons as ``np.maximum``/``np.minimum``,
+    without the overhead of ufunc calls on one-element arrays). The recorded outputs are
+    computed per block of samples from the states, ``y[k] = C x[k] + Du u[k-1] + Dd d[k]``.
+    """
+    Phi, Gu, Gd = sp.Phi, sp.Gu, sp.Gd
+    n, m = Gu.shape
+    nd = Gd.shape[1]
+    fixed = fixed_gain is not None
+    if fixed:
+        S = np.asarray(fixed_gain, dtype=float)
+        Su = np.zeros((S.shape[0], m))
+        s_add = np.zeros((n_steps + 1, 0))
+    else:
+        S, Su = sp.C[s_idx], sp.Du[s_idx]
+        s_add = _rows_times(d, sp.Dd[s_idx])  # disturbance feedthrough (and noise) per sample
+        if noise is not None:
+            s_add += noise
+    p = S.shape[0]
+    iu, idd = n + p, n + p + m
+    M = np.zeros((n + p, idd + nd))
+    M[:n, :n], M[:n, iu:idd], M[:n, idd:] = Phi, Gu, Gd
+    M[n:, :n], M[n:, iu:idd], M[n:, idd:] = S @ Phi, S @ Gu + Su, S @ Gd
+    C = sp.C[rec_idx]
+
+    Y = np.empty((n_steps + 1, len(rec_idx)))
+    X = np.empty((n_steps + 1, n)) if record_states else None
+    U = np.empty((n_steps + 1, m))
+    Cmd = np.empty((n_steps + 1, m))
+    status: list = []
+    Z = np.empty((_BLOCK + 1, idd + nd))
+    Z[0, :n] = x0
+    Z[0, n:iu] = S @ x0
+    head = Z[:, :iu]  # the part of each row the product writes
+    dot, array, minimum, maximum = np.dot, np.array, np.minimum, np.maximum
+    scalar = m == 1
+    if scalar:
+        h, pending, mg, r = 0.0, 0.0, float(mag[0]), float(rate_dt[0])
+        cmd: list = []
+        record = cmd.append
+    else:
+        h, pending, neg_mag = np.zeros(m), np.zeros(m), -mag
+    if not fixed:  # command and update of the controller's protocol
+        pending = np.zeros(m)
+        command, update, append = controller.command, controller.update, status.append
+    for k0 in range(0, n_steps + 1, _BLOCK):
+        nb = min(_BLOCK, n_steps + 1 - k0)
+        Z[:nb, idd:] = d[k0 : k0 + nb]
+        if scalar and fixed:
+            for zk, zk1 in zip(Z[:nb], head[1 : nb + 1], strict=True):
+                c = -zk.item(n)
+                if delay:
+                    c, pending = pending, c
+                lo, hi = h - r, h + r
+                u = lo if c < lo else c
+                u = hi if u > hi else u
+                u = -mg if u < -mg else u
+                u = mg if u > mg else u
+                record(c)
+                zk[iu] = u
+                dot(M, zk, zk1)
+                h = u
+        elif scalar:
+            rows = zip(
+                Z[:nb], head[1 : nb + 1], Z[:nb, :n], Z[:nb, n:iu], s_add[k0 : k0 + nb], strict=True
+            )
+            for k, (zk, zk1, xk, sk, ak) in enumerate(rows, k0):
+                ys = sk + ak
+                c = command(ys, xk.copy())
+                if delay:
+                    c, pending = pending, c
+                Cmd[k] = c
+                c = Cmd.item(k)
+                lo, hi = h - r, h + r
+                u = lo if c < lo else c
+                u = hi if u > hi else u
+                u = -mg if u < -mg else u
+                u = mg if u > mg else u
+                update(ys, array((u,)))
+                st = getattr(controller, "last_status", None)
+                if st is not None:
+                    append(st)
+                zk[iu] = u
+                dot(M, zk, zk1)
+                h = u
+        else:
+            rows = zip(
+                Z[:nb],
+                head[1 : nb + 1],
+                Z[:nb, :n],
+                Z[:nb, n:iu],
+                s_add[k0 : k0 + nb],
+                Cmd[k0 : k0 + nb],
+                strict=True,
+            )
+            for zk, zk1, xk, sk, ak, ck in rows:
+                if fixed:
+                    c = -sk
+                else:
+                    ys = sk + ak
+                    c = command(ys, xk.copy())
+                if delay:
+                    c, pending = pending, c
+                u = minimum(maximum(c, h - rate_dt), h + rate_dt)
+                u = minimum(maximum(u, neg_mag), mag)
+                if not fixed:
+                    update(ys, u)
+                    st = getattr(controller, "last_status", None)
+                    if st is not None:
+                        append(st)
+                ck[:] = c
+                zk[iu:idd] = u
+                dot(M, zk, zk1)
+                h = u
+        Y[k0 : k0 + nb] = _rows_times(Z[:nb, :n], C)
+        if X is not None:
+            X[k0 : k0 + nb] = Z[:nb, :n]
+        U[k0 : k0 + nb] = Z[:nb, iu:idd]
+        Z[0, :iu] = Z[nb, :iu]
+    if scalar and fixed:
+        Cmd[:, 0] = cmd
+    Y[1:] += _rows_times(U[:-1], sp.Du[rec_idx])
+    Y += _rows_times(d, sp.Dd[rec_idx])
+    return Y, X, U, Cmd, status
 
 
 def tip_deflection_state(builder, tip: float) -> np.ndarray:

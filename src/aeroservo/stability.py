@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from ._threads import blas_limited
 from .errors import InputError, check_int, check_number
 from .system import FirstOrderSystem
 from .tracking import EigenTracker, TrackedModes
@@ -207,6 +208,7 @@ def _as_system(model: object, density: float | None) -> tuple[FirstOrderSystem, 
     return model.system(rho), getattr(model, "label_modes", None)
 
 
+@blas_limited
 def flutter_boundary(
     model: object,
     density: float | None = None,
@@ -395,6 +397,7 @@ class EigenSweep:
     eigenvalues: np.ndarray
 
 
+@blas_limited
 def eigen_sweep(model: object, speeds: np.ndarray, density: float | None = None) -> EigenSweep:
     """Dense eigenvalues of ``A(V)`` on a grid, branch-ordered by eigenvector correlation.
 

@@ -23,6 +23,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from ._threads import blas_limited
 from .errors import InputError, check_number
 from .signals import (
     Sensor,
@@ -151,6 +152,7 @@ class StateSpaceBuilder:
         complete and consistent with the projected downwash). Default: no truncation.
     """
 
+    @blas_limited
     def __init__(
         self,
         model,

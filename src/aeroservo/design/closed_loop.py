@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
 from ..stability import sign_changes
 from .plant import SampledPlant, select
@@ -234,6 +235,7 @@ class ClosedLoopBoundary:
         return fig
 
 
+@blas_limited
 def closed_loop_boundary(
     plant_at: Callable[[float], object],
     controller,

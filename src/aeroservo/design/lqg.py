@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from .._threads import blas_limited
 from ..errors import InputError, check_number
 from .lqr import Bryson, _balanced_lqr, bryson_weights
 from .plant import SampledPlant, select
@@ -189,6 +190,7 @@ class OutputFeedback:
         self.kf.predict(u)
 
 
+@blas_limited
 def lqg(
     sys,
     controls: Sequence[str],

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from .._threads import blas_limited
 from ..errors import InputError, check_number
 from .plant import SampledPlant, select
 
@@ -137,6 +138,7 @@ def _balanced_lqr(solver, A, B, Q, R, N) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(Kt) / t[None, :], np.asarray(E)
 
 
+@blas_limited
 def lqr(
     sys,
     controls: Sequence[str],
