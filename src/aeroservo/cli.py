@@ -285,7 +285,8 @@ def _readable(s: dict) -> str:
         if "closed_loop" in s:
             c = s["closed_loop"]
             lines.append(
-                f"  closed-loop flutter speed {f(c['closed_loop_flutter_speed'], ' m/s')}; "
+                f"  closed loop loses stability at {f(c['closed_loop_flutter_speed'], ' m/s')}"
+                f" ({c['closed_loop_instability'] or 'not in range'}); "
                 f"stable intervals {[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
             )
     else:

@@ -155,7 +155,8 @@ class ClosedLoopBoundary:
     @property
     def flutter_speed(self) -> float | None:
         """Closed-loop flutter speed [m/s]: where the loop first loses stability above the
-        reference speed; None if it stays stable up to the end of the range."""
+        reference speed, through a complex pair (flutter) or a real pole (``static`` in
+        :attr:`flutter`); None if it stays stable up to the end of the range."""
         f = self.flutter
         return None if f is None else float(f["speed"])
 
@@ -180,9 +181,15 @@ class ClosedLoopBoundary:
 
     def to_dict(self) -> dict:
         """JSON-ready summary (m/s, Hz)."""
+        f = self.flutter
         return {
             "closed_loop_flutter_speed": self.flutter_speed,
             "closed_loop_flutter_frequency": self.flutter_frequency,
+            "closed_loop_instability": None
+            if f is None
+            else (
+                "static (real pole, divergence-like)" if f["static"] else "oscillatory (flutter)"
+            ),
             "reference_speed": self.reference_speed,
             "stable_at_reference": self.stable_at_reference,
             "sampled": self.sampled,

@@ -23,7 +23,7 @@ import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..errors import InputError, check_number
-from .lqr import Bryson, _balanced_lqr, bryson_weights
+from .lqr import Bryson, _balanced_lqr, cost_weights
 from .plant import SampledPlant, select
 
 __all__ = ["KalmanFilter", "kalman_filter", "OutputFeedback", "lqg"]
@@ -228,12 +228,7 @@ def lqg(
     dt = 1.0 / rate
     A, B, _, _ = select(sys, controls, [])
     n, m = B.shape
-    if bryson is not None:
-        Q, R, N = bryson_weights(sys, controls, bryson)
-    elif Q is None or R is None:
-        raise InputError("lqg: give Q and R, or bryson")
-    else:
-        Q, R, N = np.atleast_2d(Q), np.atleast_2d(R), np.zeros((n, m))
+    Q, R, N = cost_weights(sys, controls, Q, R, bryson, "lqg")
     dist = tuple(process_noise)
     sp = SampledPlant.from_statespace(sys, dt, controls, dist, list(sensors))
     kf = kalman_filter(sp, sensors, process_noise, sensor_noise)

@@ -17,7 +17,7 @@ from .._threads import blas_limited
 from ..errors import InputError, check_number
 from .plant import SampledPlant, select
 
-__all__ = ["Bryson", "bryson_weights", "StateFeedback", "lqr"]
+__all__ = ["Bryson", "bryson_weights", "cost_weights", "StateFeedback", "lqr"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +71,27 @@ def bryson_weights(
         raise InputError(f"bryson.inputs: give an allowed value for every control ({missing})")
     Q = Q + bryson.state_weight * max(np.trace(Q) / Q.shape[0], 1e-300) * np.eye(Q.shape[0])
     return 0.5 * (Q + Q.T), R, N
+
+
+def cost_weights(
+    sys, controls: Sequence[str], Q, R, bryson: Bryson | None, who: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Q, R, N)`` of a design from explicit weights or Bryson's rule (exactly one of them).
+
+    ``who`` names the calling design in error messages (``"lqr"``, ``"lqg"``, ``"mpc"``).
+    """
+    A, B, _, _ = select(sys, controls, [])
+    n, m = B.shape
+    if bryson is not None:
+        if Q is not None or R is not None:
+            raise InputError(f"{who}: give either Q and R, or bryson, not both")
+        return bryson_weights(sys, controls, bryson)
+    if Q is None or R is None:
+        raise InputError(f"{who}: give Q and R, or bryson")
+    Q, R = np.atleast_2d(Q).astype(float), np.atleast_2d(R).astype(float)
+    if Q.shape != (n, n) or R.shape != (m, m):
+        raise InputError(f"{who}: Q must be {n}x{n} and R {m}x{m}")
+    return Q, R, np.zeros((n, m))
 
 
 @dataclass
@@ -177,17 +198,7 @@ def lqr(
     rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
     A, B, _, _ = select(sys, controls, [])
     n = A.shape[0]
-    if bryson is not None:
-        if Q is not None or R is not None:
-            raise InputError("lqr: give either Q and R, or bryson, not both")
-        Q, R, N = bryson_weights(sys, controls, bryson)
-    else:
-        if Q is None or R is None:
-            raise InputError("lqr: give Q and R, or bryson")
-        Q, R = np.atleast_2d(Q).astype(float), np.atleast_2d(R).astype(float)
-        N = np.zeros((n, B.shape[1]))
-        if Q.shape != (n, n) or R.shape != (B.shape[1],) * 2:
-            raise InputError(f"lqr: Q must be {n}x{n} and R {B.shape[1]}x{B.shape[1]}")
+    Q, R, N = cost_weights(sys, controls, Q, R, bryson, "lqr")
     K, E = _balanced_lqr(control.lqr, A, B, Q, R, N)
     sp = SampledPlant.from_statespace(sys, 1.0 / rate, controls, (), [])
     Kd, _ = _balanced_lqr(control.dlqr, sp.Phi, sp.Gu, Q / rate, R / rate, N / rate)

@@ -30,7 +30,7 @@ import numpy as np
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
 from .lqg import KalmanFilter, kalman_filter, solve_dare
-from .lqr import Bryson, bryson_weights
+from .lqr import Bryson, cost_weights
 from .plant import Limits, SampledPlant, select
 
 __all__ = ["MPCController", "mpc", "SOLVERS"]
@@ -281,12 +281,7 @@ def mpc(
         raise InputError("mpc: limits must give a magnitude and a rate limit for every control")
     A, B, _, _ = select(sys, controls, [])
     n, m = B.shape
-    if bryson is not None:
-        Q, R, Ncross = bryson_weights(sys, controls, bryson)
-    elif Q is None or R is None:
-        raise InputError("mpc: give Q and R, or bryson")
-    else:
-        Q, R, Ncross = np.atleast_2d(Q), np.atleast_2d(R), np.zeros((n, m))
+    Q, R, Ncross = cost_weights(sys, controls, Q, R, bryson, "mpc")
     sp = SampledPlant.from_statespace(sys, dt, controls, tuple(process_noise), list(sensors))
     kf = kalman_filter(sp, sensors, process_noise, sensor_noise)
     Qd, Rd, Nd = Q * dt, R * dt, Ncross * dt
