@@ -124,3 +124,13 @@ def test_examples_lists_wings_and_scenarios(capsys):
     assert cli.main(["examples"]) == 0
     out = capsys.readouterr().out
     assert "goland_aileron" in out and "goland_aileron_mpc.toml" in out and "trade" in out
+
+
+def test_flutter_command_accepts_a_scenario(capsys):
+    """`aeroservo flutter SCENARIO` uses the scenario's wing, density and model options."""
+    path = ROOT / "scenarios" / "goland_aileron_lqr.toml"
+    assert cli.main(["flutter", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sc = load_scenario(path)
+    assert out["density"] == sc.density and out["n_elements"] == sc.elements
+    assert out["wing"] == sc.wing.name

@@ -53,7 +53,10 @@ def _parser() -> argparse.ArgumentParser:
         help="flutter and divergence boundaries of a wing",
         description="Flutter and divergence boundaries of a built-in wing or a wing file.",
     )
-    f.add_argument("wing", help="built-in wing (goland, goland_aileron) or path to a wing .toml")
+    f.add_argument(
+        "wing",
+        help="built-in wing (goland, goland_aileron), a wing .toml or a scenario .toml",
+    )
     f.add_argument("--json", action="store_true", help="print one JSON object")
     f.add_argument(
         "--density", type=_positive_float, help="air density [kg/m^3] (default: file, else 1.225)"
@@ -117,7 +120,17 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     from .stability import flutter_boundary
     from .wingfile import resolve_wing
 
-    wing, opts = resolve_wing(args.wing)
+    from .scenario import is_scenario_file
+
+    if args.wing.endswith(".toml") and is_scenario_file(args.wing):
+        from .scenario import load_scenario
+        from .wingfile import AnalysisOptions
+
+        sc = load_scenario(args.wing)  # a scenario: its wing, density and model options
+        wing = sc.wing
+        opts = AnalysisOptions(sc.density, sc.elements, sc.wagner, sc.v_max)
+    else:
+        wing, opts = resolve_wing(args.wing)
     density = args.density if args.density is not None else opts.density
     elements = args.elements if args.elements is not None else opts.elements
     wagner = args.wagner if args.wagner is not None else opts.wagner
