@@ -117,10 +117,9 @@ def _parser() -> argparse.ArgumentParser:
 
 def _cmd_flutter(args: argparse.Namespace) -> int:
     from .aeroelastic import AeroelasticModel
+    from .scenario import is_scenario_file
     from .stability import flutter_boundary
     from .wingfile import resolve_wing
-
-    from .scenario import is_scenario_file
 
     if args.wing.endswith(".toml") and is_scenario_file(args.wing):
         from .scenario import load_scenario
