@@ -86,10 +86,6 @@ class Scenario:
     plots: bool = True
     trade: object = None
 
-    @property
-    def folder(self) -> Path:
-        return Path(self.source).parent
-
     def model(self):
         """The aeroelastic model of the scenario's wing and options."""
         from .aeroelastic import AeroelasticModel
