@@ -134,3 +134,18 @@ def test_flutter_command_accepts_a_scenario(capsys):
     sc = load_scenario(path)
     assert out["density"] == sc.density and out["n_elements"] == sc.elements
     assert out["wing"] == sc.wing.name
+
+
+def test_trade_study_keeps_the_scenario_loop_options():
+    """filter_order and the gust model of a trade scenario reach the study and its case ids."""
+    from dataclasses import replace
+
+    from aeroservo.runs import study_from_scenario
+    from aeroservo.trade import case_id
+
+    sc = load_scenario(ROOT / "scenarios" / "trade_aileron.toml")
+    base = study_from_scenario(sc)
+    other = study_from_scenario(replace(sc, filter_order=4, gust_model="upwash"))
+    assert (other.filter_order, other.gust_model) == (4, "upwash")
+    params = {k: v[0] for k, v in base.parameters.items()}
+    assert case_id(base, params) != case_id(other, params)

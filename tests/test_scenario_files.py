@@ -29,7 +29,7 @@ from hypothesis import strategies as st
 
 from aeroservo.controller_spec import controller_from_dict, load_controller
 from aeroservo.errors import InputError
-from aeroservo.scenario import is_scenario_file, load_scenario, scenario_from_dict
+from aeroservo.scenario import TOP, is_scenario_file, load_scenario, scenario_from_dict
 
 ROOT = Path(__file__).parent.parent
 SCENARIOS = ROOT / "scenarios"
@@ -269,16 +269,7 @@ SCENARIO_HEAD = st.fixed_dictionaries(
         "flight": st.fixed_dictionaries({"density": st.floats(0.1, 2.0)}),
     }
 )
-SCENARIO_TABLES = [
-    "model",
-    "signals",
-    "disturbance",
-    "controller",
-    "simulation",
-    "analysis",
-    "output",
-    "trade",
-]
+SCENARIO_TABLES = list(TOP[3:])  # the optional tables, after scenario/wing/flight
 CONTROLLER_HEAD = st.fixed_dictionaries({"type": st.sampled_from(["none", "lqr", "lqg", "mpc"])})
 CONTROLLER_TABLES = ["weights", "limits", "estimator", "mpc", "schedule"]
 

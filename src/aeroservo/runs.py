@@ -357,6 +357,8 @@ def study_from_scenario(scenario: Scenario):
         outputs=tuple(scenario.outputs),
         design_modes=scenario.design_modes,
         sensor_filter=scenario.sensor_filter,
+        filter_order=scenario.filter_order,
+        gust_model=scenario.gust_model,
         controller=t["controller"],
         sample_rate=scenario.sample_rate,
         parameters=dict(t["parameters"]),

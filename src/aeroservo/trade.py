@@ -170,6 +170,10 @@ class TradeStudy:
         In-vacuo modes of the design model (None: full model).
     sensor_filter : float or None
         Cutoff of the accelerometer filters [Hz] (None: none).
+    filter_order : int
+        Butterworth order of those filters (1 to 4).
+    gust_model : str
+        Gust model of the plant: ``"kussner"`` or ``"upwash"``.
     controller : ControllerSpec or None
         Linear controller (type ``"lqr"`` or ``"lqg"``; the closed-loop boundary needs a linear
         loop). Needed unless ``closed_loop`` is False.
@@ -206,6 +210,8 @@ class TradeStudy:
     outputs: tuple = ("tip_disp", "tip_accel")
     design_modes: int | None = 8
     sensor_filter: float | None = 30.0
+    filter_order: int = 2
+    gust_model: str = "kussner"
     controller: ControllerSpec | None = None
     sample_rate: float = 1000.0
     parameters: dict = field(default_factory=dict)
@@ -241,6 +247,11 @@ class TradeStudy:
         put(self, "n_grid", check_int("n_grid", self.n_grid, lo=3, hi=10_000))
         if self.design_modes is not None:
             put(self, "design_modes", check_int("design_modes", self.design_modes, lo=1))
+        put(self, "filter_order", check_int("filter_order", self.filter_order, lo=1, hi=4))
+        if self.gust_model not in ("kussner", "upwash"):
+            raise InputError(
+                f"gust_model = {self.gust_model!r}: allowed values are 'kussner', 'upwash'"
+            )
         numbers = {
             "density": {"unit": "kg/m^3", "lo": 0.0, "lo_open": True},
             "sensor_filter": {"unit": "Hz", "lo": 0.0, "lo_open": True},
@@ -411,6 +422,8 @@ def study_settings(study: TradeStudy) -> dict:
             outputs=list(study.outputs),
             design_modes=study.design_modes,
             sensor_filter=study.sensor_filter,
+            filter_order=study.filter_order,
+            gust_model=study.gust_model,
             controller=spec,
             sample_rate=study.sample_rate,
             gust_length=study.gust_length,
@@ -528,7 +541,15 @@ def _stage_model(study: TradeStudy, wing: Wing) -> dict:
 def _loop(study: TradeStudy, entry: dict):
     from .loop import ControlLoop
 
-    key = (study.controls, study.sensors, study.outputs, study.design_modes, study.sensor_filter)
+    key = (
+        study.controls,
+        study.sensors,
+        study.outputs,
+        study.design_modes,
+        study.sensor_filter,
+        study.filter_order,
+        study.gust_model,
+    )
     if key not in entry["loops"]:
         entry["loops"][key] = ControlLoop(
             entry["model"],
@@ -538,6 +559,8 @@ def _loop(study: TradeStudy, entry: dict):
             list(study.outputs),
             design_modes=study.design_modes,
             sensor_filter=study.sensor_filter,
+            filter_order=study.filter_order,
+            gust=study.gust_model,
         )
     return entry["loops"][key]
 
