@@ -272,17 +272,16 @@ def load_result(path: str | Path):
         raise InputError(
             f"{path}: not an aeroservo simulation result (format {meta.get('format')})"
         )
-    res = SimulationResult(
+    return SimulationResult(
         t=t,
         status=[],
         limits=Limits(**meta["limits"]),
         units=meta["units"],
         speed=meta["speed"],
         density=meta["density"],
+        summary=meta.get("summary", {}),
         **groups,
     )
-    res.summary = meta.get("summary", {})
-    return res
 
 
 @blas_limited

@@ -47,6 +47,9 @@ class SimulationResult:
     wall_time : float
         Wall time of the time marching and output evaluation [s] (the discretization of the
         plant before it is not included).
+    summary : dict
+        Run summary of a result read back by :func:`aeroservo.runs.load_result` (empty
+        otherwise).
     """
 
     t: np.ndarray
@@ -61,6 +64,7 @@ class SimulationResult:
     density: float = float("nan")
     states: np.ndarray | None = None
     wall_time: float = 0.0
+    summary: dict = field(default_factory=dict)
 
     def signal(self, name: str) -> np.ndarray:
         """Any recorded signal by name."""
