@@ -181,7 +181,6 @@ class OutputFeedback:
 
     def reset(self) -> None:
         self.kf.reset()
-        self.status = {}
 
     def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
         return -(self.K @ self.kf.correct(y))

@@ -133,7 +133,7 @@ class StateFeedback:
 
     # sampled-controller protocol used by the simulator
     def reset(self) -> None:
-        self.status = {}
+        pass  # stateless
 
     def command(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
         return -(self.gain @ x)
