@@ -34,6 +34,7 @@ bench: install
 	$(BIN)/python bench/bench_flutter.py
 	$(BIN)/python bench/bench_statespace.py
 	$(BIN)/python bench/bench_control.py
+	$(BIN)/python bench/bench_mpc.py
 	$(BIN)/python bench/bench_trade.py
 
 clean:

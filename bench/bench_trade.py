@@ -3,7 +3,7 @@
 N open-loop flutter boundaries of Goland-with-aileron variants (a full grid of
 ``aileron_start`` x ``aileron_chord`` x ``hinge_stiffness`` x ``actuator_station``, 5 x 5 x 5 x k
 values; the closed loop is left out: ``TradeStudy(closed_loop=False)``), each run through
-:func:`aeroservo.trade.run_trade` (case files, CSV and NetCDF included) on a warmed-up
+:func:`aeroservo.studies.trade.run_trade` (case files, CSV and NetCDF included) on a warmed-up
 ``LocalCluster`` with 1 worker and then with 2 workers. Reported: cases per second for each,
 the speed-up (target: 2 workers >= 1.7 x 1 worker on a 2-core machine), the projected time of
 10 000 cases on 2 workers, and the median compute time of one case (the rest is overhead).
@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 import aeroservo as aes
-from aeroservo import trade
+from aeroservo.studies import trade
 
 
 def grid_study(n_cases: int) -> trade.TradeStudy:

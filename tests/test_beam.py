@@ -7,7 +7,7 @@ import scipy.linalg as sla
 from conftest import reference
 
 import aeroservo as aes
-from aeroservo.model import Segment, Wing
+from aeroservo.structure import Segment, Wing
 
 L, EI, GJ, M, I_EA = 5.0, 2.0e6, 3.0e5, 20.0, 1.5
 

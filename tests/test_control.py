@@ -13,10 +13,12 @@ import numpy as np
 import pytest
 
 import aeroservo as aes
+from aeroservo.aero import OneMinusCosine, Turbulence
 from aeroservo.design import (
     Bryson,
     Limits,
     OpenLoop,
+    SampledPlant,
     closed_loop_boundary,
     closed_loop_matrix,
     lqg,
@@ -26,10 +28,9 @@ from aeroservo.design import (
     state_map,
     with_sensor_filters,
 )
-from aeroservo.design.plant import SampledPlant
 from aeroservo.errors import InputError
-from aeroservo.gusts import OneMinusCosine, Turbulence
-from aeroservo.simulate import simulate, tip_deflection_state
+from aeroservo.linear.models import tip_deflection_state
+from aeroservo.simulate import simulate
 
 RHO = 1.225
 HM = "aileron_hinge_moment"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import aeroservo as aes
-from aeroservo.model import Actuator, ControlSurface, Segment, Wing
+from aeroservo.structure import Actuator, ControlSurface, Segment, Wing
 
 
 def test_flap_unknowns_only_on_the_surface(aileron10):

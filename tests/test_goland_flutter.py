@@ -6,7 +6,7 @@ import scipy.linalg as sla
 from conftest import reference
 
 import aeroservo as aes
-from aeroservo.pk import pk_flutter
+from aeroservo.stability import pk_flutter
 
 SEA_LEVEL = 1.225
 

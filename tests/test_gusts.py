@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from aeroservo.aero import GustSeries, OneMinusCosine, Turbulence
+from aeroservo.aero.gusts import dryden_psd, von_karman_psd
 from aeroservo.errors import InputError
-from aeroservo.gusts import GustSeries, OneMinusCosine, Turbulence, dryden_psd, von_karman_psd
 
 
 def test_one_minus_cosine_shape():

@@ -8,9 +8,10 @@ import pytest
 from conftest import ROOT
 
 from aeroservo import cli
-from aeroservo.examples import shipped_scenarios
-from aeroservo.runs import load_result, run_simulation
-from aeroservo.scenario import load_scenario, quick
+from aeroservo.files import load_result, load_scenario, write_run
+from aeroservo.files.scenario_file import shipped_scenarios
+from aeroservo.studies import quick
+from aeroservo.studies.runs import run_simulation
 
 SCENARIOS = [p for p, _kind, _name in shipped_scenarios()]
 
@@ -52,7 +53,9 @@ def test_every_shipped_scenario_runs(path, tmp_path, capsys):
 
 def test_simulation_summary_and_result_roundtrip(tmp_path):
     sc = quick(load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml"))
-    res, summary = run_simulation(sc, tmp_path)
+    run = run_simulation(sc)
+    write_run(run, tmp_path)
+    res, summary = run.simulation, run.summary
     assert summary["speed"] == pytest.approx(1.1 * summary["open_loop_flutter_speed"])
     cl = summary["closed_loop"]
     assert cl["closed_loop_flutter_speed"] > summary["speed"]
@@ -72,7 +75,7 @@ def test_simulation_summary_and_result_roundtrip(tmp_path):
 
 def test_plot_command_replots_a_result(tmp_path, capsys):
     sc = quick(load_scenario(ROOT / "scenarios" / "goland_aileron_open_loop.toml"))
-    run_simulation(sc, tmp_path)
+    write_run(run_simulation(sc), tmp_path)
     npz = tmp_path / "goland_aileron_open_loop.npz"
     assert cli.main(["plot", str(npz)]) == 0
     png = npz.with_suffix(".png")
@@ -91,9 +94,10 @@ def test_failed_write_leaves_no_partial_result(tmp_path, monkeypatch):
         fh.write(b"PK partial")
         raise OSError("disk full")
 
+    run = run_simulation(sc)
     monkeypatch.setattr(np, "savez_compressed", broken)
     with pytest.raises(OSError, match="disk full"):
-        run_simulation(sc, tmp_path)
+        write_run(run, tmp_path)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -110,7 +114,7 @@ def test_exit_codes(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert "wing.builtin = 'concorde'" in err and len(err.strip().splitlines()) == 1
     # numerical failure: exit 1 with a message
-    import aeroservo.stability as stab
+    import aeroservo.stability.boundary as stab
 
     def fails(*a, **k):
         raise RuntimeError("eigenvalue tracking failed near V = 1 m/s")
@@ -140,8 +144,8 @@ def test_trade_study_keeps_the_scenario_loop_options():
     """filter_order and the gust model of a trade scenario reach the study and its case ids."""
     from dataclasses import replace
 
-    from aeroservo.runs import study_from_scenario
-    from aeroservo.trade import case_id
+    from aeroservo.studies.runs import study_from_scenario
+    from aeroservo.studies.trade import case_id
 
     sc = load_scenario(ROOT / "scenarios" / "trade_aileron.toml")
     base = study_from_scenario(sc)

@@ -27,9 +27,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from aeroservo.controller_spec import controller_from_dict, load_controller
 from aeroservo.errors import InputError
-from aeroservo.scenario import TOP, is_scenario_file, load_scenario, scenario_from_dict
+from aeroservo.files import load_controller, load_scenario
+from aeroservo.files.controller_file import controller_from_dict
+from aeroservo.files.scenario_file import TOP, is_scenario_file, scenario_from_dict
 
 ROOT = Path(__file__).parent.parent
 SCENARIOS = ROOT / "scenarios"

@@ -6,8 +6,8 @@ import pytest
 from conftest import reference
 
 import aeroservo as aes
-from aeroservo.pk import pk_flutter
-from aeroservo.section import TypicalSection
+from aeroservo.stability import pk_flutter
+from aeroservo.system import TypicalSection
 
 RHO = 1.225
 B, W_ALPHA = 0.5, 50.0  # HP-1 is non-dimensional: any semichord and pitch frequency

@@ -13,9 +13,9 @@ import pytest
 import scipy.sparse as sp
 
 import aeroservo as aes
-from aeroservo.stability import _find_crossings
+from aeroservo.stability.boundary import _find_crossings
+from aeroservo.stability.tracking import EigenTracker, TrackedModes
 from aeroservo.system import FirstOrderSystem
-from aeroservo.tracking import EigenTracker, TrackedModes
 
 
 class Synthetic(FirstOrderSystem):

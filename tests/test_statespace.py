@@ -5,16 +5,16 @@ import numpy as np
 import pytest
 
 import aeroservo as aes
-from aeroservo.reduction import balanced_truncation, compare_frequency_response
-from aeroservo.signals import sensor_row
-from aeroservo.statespace import (
+from aeroservo.files import export_mat, export_npz
+from aeroservo.linear import (
     StateSpaceBuilder,
+    balanced_truncation,
+    compare_frequency_response,
     discretize,
-    export_mat,
-    export_npz,
     modal_controllability,
     statespace,
 )
+from aeroservo.linear.signals import sensor_row
 
 RHO = 1.225
 
@@ -121,7 +121,7 @@ def test_frequency_response_matches_direct_solve(aileron10):
     M = d(am.Ms) + RHO * d(am.Mnc)
     Ca = d(am.Cnc) - scale * d(am.Pd)
     Ka = d(am.Knc) - scale * d(am.Pq)
-    from aeroservo.signals import hinge_moment_vector
+    from aeroservo.linear.signals import hinge_moment_vector
 
     f = hinge_moment_vector(aileron10, 0)
     rows = [
@@ -278,7 +278,7 @@ def test_export_roundtrip(tmp_path, aileron10):
 
 
 def test_family_reuses_the_assembly(aileron10, monkeypatch):
-    import aeroservo.aeroelastic as mod
+    import aeroservo.system.aeroelastic as mod
 
     speeds = np.linspace(60, 160, 6)
     fam = aes.statespace_family(aileron10, speeds, RHO)
@@ -365,7 +365,7 @@ def test_bad_servo(args, match):
 
 
 def test_command_needs_actuators():
-    from aeroservo.model import ControlSurface, Segment, Wing
+    from aeroservo.structure import ControlSurface, Segment, Wing
 
     seg = Segment(0, 4, 0.5, -0.3, 10, 0.1, 1.0, 1e6, 1e5)
     wing = Wing(4, [seg], [ControlSurface("flap", 2, 4, 0.5, 0.05, 0.02, hinge_stiffness=50.0)])

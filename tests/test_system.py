@@ -59,7 +59,7 @@ def test_state_count(wagner, n_terms):
 
 def test_speed_independent_matrices_built_once(aileron10, monkeypatch):
     """Sweeping speeds never re-assembles: assembly is not called after construction."""
-    import aeroservo.aeroelastic as mod
+    import aeroservo.system.aeroelastic as mod
 
     def boom(*a, **k):
         raise AssertionError("re-assembled")

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from conftest import reference
 
-from aeroservo.theodorsen import section_aero, t_functions, theodorsen_function
+from aeroservo.aero import section_aero, theodorsen_function
+from aeroservo.aero.theodorsen import t_functions
 
 
 def test_theodorsen_function_table():

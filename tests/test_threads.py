@@ -32,7 +32,7 @@ def test_limited_inside_restored_outside(monkeypatch):
 
 
 def test_flutter_boundary_runs_single_threaded(goland10, monkeypatch):
-    import aeroservo.tracking as tr
+    import aeroservo.stability.tracking as tr
 
     seen = []
     original = tr.EigenTracker.track

@@ -20,9 +20,10 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 import aeroservo as aes
-from aeroservo import trade
-from aeroservo.controller_spec import load_controller
 from aeroservo.errors import InputError
+from aeroservo.files import load_controller
+from aeroservo.studies import trade
+from aeroservo.studies.trade.cluster import _worker_probe
 
 ROOT = Path(__file__).parent.parent
 GOOD, BAD = 0.8, 0.3  # actuator stations [fraction of span]: on / off the aileron (0.6-1.0)
@@ -57,7 +58,7 @@ def test_workers_are_single_threaded(cluster):
     from distributed import Client
 
     with Client(cluster.scheduler_address, timeout="30s") as client:
-        info = client.run(trade._worker_probe)
+        info = client.run(_worker_probe)
     assert len(info) == 2
     for w in info.values():
         assert w["OMP_NUM_THREADS"] == w["OPENBLAS_NUM_THREADS"] == w["MKL_NUM_THREADS"] == "1"

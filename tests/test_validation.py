@@ -5,7 +5,7 @@ import dataclasses
 import pytest
 
 import aeroservo as aes
-from aeroservo.model import Actuator, ControlSurface, Segment, Wing
+from aeroservo.structure import Actuator, ControlSurface, Segment, Wing
 
 SEG = dict(
     start=0.0,

@@ -5,15 +5,8 @@ import pytest
 from conftest import reference
 
 from aeroservo import InputError
-from aeroservo.theodorsen import theodorsen_function
-from aeroservo.wagner import (
-    KUSSNER_SETS,
-    WAGNER_SETS,
-    IndicialSet,
-    fit_wagner,
-    wagner_exact,
-    wagner_set,
-)
+from aeroservo.aero import KUSSNER_SETS, WAGNER_SETS, IndicialSet, theodorsen_function, wagner_set
+from aeroservo.aero.indicial import fit_wagner, wagner_exact
 
 
 def test_exact_wagner_table():

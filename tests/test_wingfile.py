@@ -7,7 +7,8 @@ import pytest
 from conftest import ROOT
 
 import aeroservo as aes
-from aeroservo.wingfile import AnalysisOptions, load_wing, resolve_wing
+from aeroservo.files import load_wing, resolve_wing
+from aeroservo.files.wing_file import AnalysisOptions
 
 
 @pytest.mark.parametrize(

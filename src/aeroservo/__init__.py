@@ -1,17 +1,21 @@
 """aeroservo: time-domain aero-servo-elastic analysis of wings with control surfaces."""
 
-from . import examples
-from .aeroelastic import AeroelasticModel, NaturalModes
+from ._version import __version__
+from .aero.indicial import KUSSNER_SETS, WAGNER_SETS, IndicialSet
 from .errors import InputError
-from .model import Actuator, ControlSurface, Segment, Wing
-from .signals import Sensor
-from .stability import FlutterResult, divergence_speed, eigen_sweep, flutter_boundary
-from .statespace import Servo, StateSpaceBuilder, statespace, statespace_family
-from .wagner import KUSSNER_SETS, WAGNER_SETS, IndicialSet
-
-__version__ = "0.1.0"
+from .linear.models import statespace, statespace_family
+from .linear.signals import Sensor
+from .linear.state_space import Servo, StateSpaceBuilder
+from .stability.boundary import flutter_boundary
+from .stability.divergence import divergence_speed
+from .stability.result import FlutterResult
+from .stability.sweep import eigen_sweep
+from .structure import examples
+from .structure.wing import Actuator, ControlSurface, Segment, Wing
+from .system.aeroelastic import AeroelasticModel, NaturalModes
 
 __all__ = [
+    "__version__",
     "AeroelasticModel",
     "Actuator",
     "ControlSurface",

@@ -39,7 +39,7 @@ def _positive_int(text: str) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    from . import __version__
+    from ._version import __version__
 
     p = argparse.ArgumentParser(
         prog="aeroservo",
@@ -116,14 +116,14 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _cmd_flutter(args: argparse.Namespace) -> int:
-    from .aeroelastic import AeroelasticModel
-    from .scenario import is_scenario_file
-    from .stability import flutter_boundary
-    from .wingfile import resolve_wing
+    from .files.scenario_file import is_scenario_file
+    from .files.wing_file import resolve_wing
+    from .stability.boundary import flutter_boundary
+    from .system.aeroelastic import AeroelasticModel
 
     if args.wing.endswith(".toml") and is_scenario_file(args.wing):
-        from .scenario import load_scenario
-        from .wingfile import AnalysisOptions
+        from .files.scenario_file import load_scenario
+        from .files.wing_file import AnalysisOptions
 
         sc = load_scenario(args.wing)  # a scenario: its wing, density and model options
         wing = sc.wing
@@ -150,7 +150,7 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     }
     out.update({k: v for k, v in result.to_dict().items() if k not in out})
     if args.pk:
-        from .pk import pk_flutter
+        from .stability.pk import pk_flutter
 
         pk = pk_flutter(model, density, v_max=result.v_max, n_modes=n_modes)
         out["pk_exact_theodorsen"] = {
@@ -159,7 +159,7 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
             "divergence_speed": pk.divergence_speed,
         }
     if args.plot:
-        from .fileio import save_figure
+        from .atomic import save_figure
         from .plots import plot_vg
 
         fig = plot_vg(
@@ -187,8 +187,8 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
 
 
 def _cmd_modes(args: argparse.Namespace) -> int:
-    from .aeroelastic import AeroelasticModel
-    from .wingfile import resolve_wing
+    from .files.wing_file import resolve_wing
+    from .system.aeroelastic import AeroelasticModel
 
     wing, opts = resolve_wing(args.wing)
     model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
@@ -213,7 +213,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 
 
 def _cmd_examples(args: argparse.Namespace) -> int:
-    from .examples import BUILTIN_WINGS, shipped_scenarios
+    from .files.scenario_file import shipped_scenarios
+    from .structure.examples import BUILTIN_WINGS
 
     print("built-in wings:")
     for name, fn in BUILTIN_WINGS.items():
@@ -230,8 +231,11 @@ def _cmd_examples(args: argparse.Namespace) -> int:
 def _cmd_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from .runs import run_scenario
-    from .scenario import load_scenario, quick
+    from .files.outputs import write_run
+    from .files.results import json_text
+    from .files.scenario_file import load_scenario
+    from .studies.runs import run_scenario
+    from .studies.scenario import quick
 
     scenario = load_scenario(args.scenario)
     if args.command != "run" and scenario.kind != args.command:
@@ -244,17 +248,17 @@ def _cmd_run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
-    summary = run_scenario(
+    run = run_scenario(
         scenario,
         out,
         progress=progress,
         scheduler=getattr(args, "scheduler", None),
         workers=getattr(args, "workers", None),
     )
+    write_run(run, out)
+    summary = run.summary
     if args.json:
-        from .runs import _dumps
-
-        print(_dumps(summary))
+        print(json_text(summary))
     else:
         print(_readable(summary))
     return 0
@@ -308,7 +312,7 @@ def _readable(s: dict) -> str:
         )
         b = s.get("best_case")
         if b:
-            from .trade import PARAMETERS
+            from .studies.trade.study import PARAMETERS
 
             params = ", ".join(f"{k} = {b[k]:g}" for k in PARAMETERS if k in b)
             lines.append(
@@ -325,8 +329,8 @@ def _readable(s: dict) -> str:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from .fileio import save_figure
-    from .runs import load_result
+    from .atomic import save_figure
+    from .files.results import load_result
 
     res = load_result(args.result)
     out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")

@@ -13,8 +13,8 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-    from .aeroelastic import AeroelasticModel, NaturalModes
-    from .stability import FlutterResult
+    from .stability.result import FlutterResult
+    from .system.aeroelastic import AeroelasticModel, NaturalModes
 
 __all__ = ["plot_vg", "plot_root_locus", "plot_mode_shapes"]
 

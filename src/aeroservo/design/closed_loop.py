@@ -11,8 +11,9 @@ stability measure is
 
 Both are continuous functions of speed whose sign changes are exactly the closed-loop stability
 boundaries. They are bracketed on a speed grid and found by Brent's method to a relative
-tolerance ``rtol`` (the open-loop root finder, :func:`aeroservo.stability.sign_changes`), with
-the same search for humps that cross zero between grid points.
+tolerance ``rtol`` (the open-loop root finder,
+:func:`aeroservo.stability.boundary.sign_changes`), with the same search for humps that
+cross zero between grid points.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import numpy as np
 
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
-from ..stability import sign_changes
+from ..stability.boundary import sign_changes
 from .plant import SampledPlant, select
 
 __all__ = ["ClosedLoopBoundary", "closed_loop_boundary", "closed_loop_matrix"]

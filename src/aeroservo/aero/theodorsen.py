@@ -1,0 +1,197 @@
+"""Theodorsen's thin-airfoil unsteady aerodynamics with a trailing-edge flap.
+
+Theodorsen (1935), NACA Report 496, written in aeroservo's coordinates (``docs/conventions.md``):
+section unknowns ``[w, phi, delta]`` = plunge of the elastic axis (up), twist (nose-up) and
+flap rotation (trailing-edge down). Theodorsen's plunge h is positive down, so h = -w.
+
+The generalized section loads are ``f = [L, M_alpha, M_beta]`` (lift up [N/m], pitching
+moment about the elastic axis nose-up [N m/m], hinge moment trailing-edge down [N m/m]):
+
+* non-circulatory part: ``-rho * (Mnc qdd + U Cnc qd + U^2 Knc q)``
+* circulatory part: ``rho U b w (C Q)``, with the 3/4-chord downwash
+  ``Q = U r_q.q + r_d.qd = U phi - wd + b(1/2 - a) phid + (U/pi) T10 delta + (b/2pi) T11 deltad``.
+
+``C Q`` is ``C(k) Q`` for harmonic motion and a Wagner convolution in the time domain
+(:mod:`aeroservo.aero.indicial`). All coefficient arrays are per unit air density and exclude the
+factors of U shown above, so they are built once and scaled at every speed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["theodorsen_function", "t_functions", "SectionAero", "section_aero"]
+
+
+def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
+    """Theodorsen's function C(k) = H1(2)(k) / (H1(2)(k) + i H0(2)(k)).
+
+    Parameters
+    ----------
+    k : array_like
+        Reduced frequency omega b / U [-], k >= 0. C(0) = 1.
+
+    Returns
+    -------
+    complex or ndarray of complex
+        C(k) = F(k) + i G(k).
+    """
+    from scipy.special import hankel2
+
+    k_arr = np.asarray(k, dtype=float)
+    if np.any(k_arr < 0) or not np.all(np.isfinite(k_arr)):
+        raise ValueError(f"k = {k!r}: reduced frequency must be finite and >= 0")
+    out = np.ones(k_arr.shape, dtype=complex)
+    pos = k_arr > 0
+    kp = k_arr[pos]
+    h1 = hankel2(1, kp)
+    h0 = hankel2(0, kp)
+    out[pos] = h1 / (h1 + 1j * h0)
+    return out if out.ndim else complex(out)
+
+
+def t_functions(c: np.ndarray | float, a: np.ndarray | float) -> dict[str, np.ndarray]:
+    """Theodorsen's flap geometry functions T1..T14.
+
+    Parameters
+    ----------
+    c : array_like
+        Hinge position in semichords aft of mid-chord [-], -1 <= c <= 1. c = 1 is a
+        zero-chord flap, for which every T vanishes except T14.
+    a : array_like
+        Elastic-axis position in semichords aft of mid-chord [-].
+
+    Returns
+    -------
+    dict
+        Keys ``"T1"`` .. ``"T14"``, arrays broadcast from ``c`` and ``a``.
+    """
+    c = np.asarray(c, dtype=float)
+    a = np.asarray(a, dtype=float)
+    c, a = np.broadcast_arrays(c, a)
+    th = np.arccos(np.clip(c, -1.0, 1.0))
+    s = np.sqrt(np.clip(1.0 - c**2, 0.0, None))
+    t = {}
+    t["T1"] = -s * (2.0 + c**2) / 3.0 + c * th
+    t["T2"] = c * (1.0 - c**2) - s * (1.0 + c**2) * th + c * th**2
+    t["T3"] = (
+        -(1.0 / 8.0 + c**2) * th**2
+        + 0.25 * c * s * th * (7.0 + 2.0 * c**2)
+        - (1.0 / 8.0) * (1.0 - c**2) * (5.0 * c**2 + 4.0)
+    )
+    t["T4"] = -th + c * s
+    t["T5"] = -(1.0 - c**2) - th**2 + 2.0 * c * s * th
+    t["T6"] = t["T2"]
+    t["T7"] = -(1.0 / 8.0 + c**2) * th + (1.0 / 8.0) * c * s * (7.0 + 2.0 * c**2)
+    t["T8"] = -s * (2.0 * c**2 + 1.0) / 3.0 + c * th
+    t["T9"] = 0.5 * (s**3 / 3.0 + a * t["T4"])
+    t["T10"] = s + th
+    t["T11"] = th * (1.0 - 2.0 * c) + s * (2.0 - c)
+    t["T12"] = s * (2.0 + c) - th * (2.0 * c + 1.0)
+    t["T13"] = 0.5 * (-t["T7"] - (c - a) * t["T1"])
+    t["T14"] = 1.0 / 16.0 + 0.5 * a * c
+    return t
+
+
+@dataclass(frozen=True)
+class SectionAero:
+    """Per-unit-density section coefficients for unknowns ``[w, phi, delta]``.
+
+    Leading dimensions are those of the inputs (e.g. one entry per quadrature point).
+
+    Attributes
+    ----------
+    Mnc : ndarray (..., 3, 3)
+        Apparent mass [m^2, m^3, m^4 entries], multiplies rho * qdd on the left-hand side.
+    Cnc : ndarray (..., 3, 3)
+        Non-circulatory damping, multiplies rho * U * qd.
+    Knc : ndarray (..., 3, 3)
+        Non-circulatory stiffness, multiplies rho * U^2 * q.
+    w : ndarray (..., 3)
+        Distribution of the circulatory load: f_circ = rho U b w (C Q).
+    r_q, r_d : ndarray (..., 3)
+        Downwash weights: Q = U r_q.q + r_d.qd.
+    b : ndarray (...)
+        Semichord [m].
+    """
+
+    Mnc: np.ndarray
+    Cnc: np.ndarray
+    Knc: np.ndarray
+    w: np.ndarray
+    r_q: np.ndarray
+    r_d: np.ndarray
+    b: np.ndarray
+
+    @property
+    def Pq(self) -> np.ndarray:
+        """Circulatory stiffness per unit C(k): ``b w r_q^T`` (multiplies rho U^2 C)."""
+        return self.b[..., None, None] * self.w[..., :, None] * self.r_q[..., None, :]
+
+    @property
+    def Pd(self) -> np.ndarray:
+        """Circulatory damping per unit C(k): ``b w r_d^T`` (multiplies rho U C)."""
+        return self.b[..., None, None] * self.w[..., :, None] * self.r_d[..., None, :]
+
+
+def section_aero(
+    b: np.ndarray | float, a: np.ndarray | float, c: np.ndarray | float
+) -> SectionAero:
+    """Theodorsen section coefficients, flap terms included.
+
+    Parameters
+    ----------
+    b : array_like
+        Semichord [m].
+    a : array_like
+        Elastic axis, semichords aft of mid-chord [-].
+    c : array_like
+        Hinge line, semichords aft of mid-chord [-]; use c = 1 where there is no flap
+        (all flap terms then vanish).
+
+    Returns
+    -------
+    SectionAero
+    """
+    b, a, c = np.broadcast_arrays(
+        np.asarray(b, dtype=float), np.asarray(a, dtype=float), np.asarray(c, dtype=float)
+    )
+    T = t_functions(c, a)
+    pi = np.pi
+    z = np.zeros_like(b)
+    b2 = b**2
+
+    def mat(rows):
+        return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+    Mnc = b2[..., None, None] * mat(
+        [
+            [pi + z, pi * b * a, b * T["T1"]],
+            [pi * a * b, pi * b2 * (1.0 / 8.0 + a**2), -(T["T7"] + (c - a) * T["T1"]) * b2],
+            [T["T1"] * b, 2.0 * T["T13"] * b2, -(b2 / pi) * T["T3"]],
+        ]
+    )
+    Cnc = b2[..., None, None] * mat(
+        [
+            [z, -pi + z, T["T4"]],
+            [z, pi * (0.5 - a) * b, (T["T1"] - T["T8"] - (c - a) * T["T4"] + 0.5 * T["T11"]) * b],
+            [
+                z,
+                (-2.0 * T["T9"] - T["T1"] + T["T4"] * (a - 0.5)) * b,
+                -(b / (2 * pi)) * T["T4"] * T["T11"],
+            ],
+        ]
+    )
+    Knc = b2[..., None, None] * mat(
+        [
+            [z, z, z],
+            [z, z, T["T4"] + T["T10"]],
+            [z, z, (T["T5"] - T["T4"] * T["T10"]) / pi],
+        ]
+    )
+    w = np.stack([2 * pi + z, 2 * pi * b * (a + 0.5), -b * T["T12"]], axis=-1)
+    r_q = np.stack([z, 1.0 + z, T["T10"] / pi], axis=-1)
+    r_d = np.stack([-1.0 + z, b * (0.5 - a), b * T["T11"] / (2 * pi)], axis=-1)
+    return SectionAero(Mnc=Mnc, Cnc=Cnc, Knc=Knc, w=w, r_q=r_q, r_d=r_d, b=b)

@@ -1,0 +1,245 @@
+"""A flutter-suppression loop: plant and design models of one wing, and controller design.
+
+:class:`ControlLoop` holds, for one wing model and air density,
+
+* the **plant**: the full state-space model (every FE unknown), used for simulation and
+  closed-loop stability;
+* the **design model**: a modal truncation (``design_modes`` in-vacuo modes, lag states kept
+  complete) on which LQG and MPC are designed (LQR too, with its gain mapped back onto the
+  plant states);
+
+both with the same analogue low-pass filters on the accelerometers (sensors with a direct
+feedthrough), so that a design on the truncated model stays consistent with the plant. It
+turns a :class:`~aeroservo.design.spec.ControllerSpec` into a controller at a design speed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import InputError, check_int, check_number
+from ..linear.models import tip_deflection_state
+from ..linear.state_space import StateSpaceBuilder
+from .lqg import lqg
+from .lqr import Bryson, lqr
+from .mpc import mpc
+from .plant import OpenLoop, state_map, with_sensor_filters
+from .schedule import GainSchedule, schedule
+from .spec import ControllerSpec
+
+__all__ = ["ControlLoop", "check_spec_signals"]
+
+
+class ControlLoop:
+    """Plant and design models of a wing with named controls and sensors.
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    density : float
+        Air density [kg/m^3].
+    controls : sequence of str
+        Control inputs, e.g. ``["aileron_hinge_moment"]``.
+    sensors : sequence of str
+        Measured outputs read by output-feedback controllers.
+    outputs : sequence of str
+        Further outputs (recorded, weighted or limited); the sensors are always included.
+    design_modes : int or None
+        In-vacuo modes kept in the design model (None: the full model).
+    sensor_filter : float or None
+        Cutoff [Hz] of the Butterworth filters on the acceleration sensors (None: no filters).
+    filter_order : int
+        Order of those filters.
+    gust : str
+        Gust model of the plant (``"kussner"`` or ``"upwash"``).
+    """
+
+    def __init__(
+        self,
+        model,
+        density: float,
+        controls: Sequence[str],
+        sensors: Sequence[str],
+        outputs: Sequence[str] = (),
+        *,
+        design_modes: int | None = 8,
+        sensor_filter: float | None = 30.0,
+        filter_order: int = 2,
+        gust: str = "kussner",
+    ):
+        self.model = model
+        self.density = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+        self.controls = list(controls)
+        self.sensors = list(sensors)
+        if not self.controls:
+            raise InputError("controls: give at least one control input")
+        self.outputs = list(dict.fromkeys(self.sensors + list(outputs)))
+        inputs = self.controls + (["gust"] if "gust" not in self.controls else [])
+        self.plant_builder = StateSpaceBuilder(model, self.density, inputs, self.outputs, gust=gust)
+        if design_modes is not None:
+            design_modes = check_int("design_modes", design_modes, lo=1, hi=model.n_dofs)
+        self.design_modes = design_modes
+        self.design_builder = (
+            StateSpaceBuilder(
+                model, self.density, inputs, self.outputs, gust=gust, n_modes=design_modes
+            )
+            if design_modes is not None
+            else self.plant_builder
+        )
+        units = self.plant_builder.units
+        self.filtered = [s for s in self.sensors if units[s] == "m/s^2"]
+        if sensor_filter is not None:
+            check_number("sensor_filter", sensor_filter, unit="Hz", lo=0.0, lo_open=True)
+        self.sensor_filter = sensor_filter if self.filtered else None
+        self.filter_order = filter_order
+        self.T = state_map(self.plant_builder, self.design_builder)
+
+    @property
+    def units(self) -> dict:
+        """Signal units by name."""
+        return dict(self.plant_builder.units)
+
+    def _filter(self, sys):
+        if self.sensor_filter is None:
+            return sys
+        return with_sensor_filters(sys, self.filtered, self.sensor_filter, self.filter_order)
+
+    def plant(self, speed: float):
+        """Full plant at ``speed`` [m/s] (``control.StateSpace``, filters included)."""
+        return self._filter(self.plant_builder.at(speed))
+
+    def design(self, speed: float, filtered: bool = True):
+        """Design model at ``speed`` [m/s] (truncated; filters included if ``filtered``)."""
+        d = self.design_builder.at(speed)
+        return self._filter(d) if filtered else d
+
+    @property
+    def n_filter_states(self) -> int:
+        return self.filter_order * len(self.filtered) if self.sensor_filter is not None else 0
+
+    def plant_state_map(self) -> np.ndarray:
+        """``x_design = T x_plant`` for the unfiltered design model (filter states ignored)."""
+        return np.hstack([self.T, np.zeros((self.T.shape[0], self.n_filter_states))])
+
+    def initial_state(self, tip: float) -> np.ndarray:
+        """Plant state with the static tip-load shape scaled to a tip deflection ``tip`` [m]."""
+        x = tip_deflection_state(self.plant_builder, tip)
+        return np.r_[x, np.zeros(self.n_filter_states)]
+
+    def bryson(self, spec: ControllerSpec) -> Bryson:
+        return Bryson(spec.bryson_outputs, spec.bryson_inputs, spec.state_weight)
+
+    def check_spec(self, spec: ControllerSpec) -> None:
+        """Every signal of a spec must be a control, a sensor or an output of this loop."""
+        check_spec_signals(spec, self.controls, self.sensors, self.outputs)
+
+    def design_controller(
+        self,
+        spec: ControllerSpec,
+        speed: float,
+        sample_rate: float,
+        flutter_speed: float | None = None,
+    ):
+        """The controller a spec describes, designed at ``speed`` [m/s].
+
+        Parameters
+        ----------
+        spec : ControllerSpec
+        speed : float
+            Design speed [m/s].
+        sample_rate : float
+            Controller sample rate [Hz].
+        flutter_speed : float, optional
+            Open-loop flutter speed [m/s], needed by a gain schedule (its speeds are multiples
+            of it).
+
+        Returns
+        -------
+        OpenLoop, StateFeedback, OutputFeedback, GainSchedule or MPCController
+        """
+        self.check_spec(spec)
+        rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+        if spec.type == "none":
+            return OpenLoop(tuple(self.controls), 1.0 / rate)
+        if spec.type == "mpc":
+            return mpc(
+                self.design(speed),
+                self.controls,
+                self.sensors,
+                limits=spec.limits,
+                process_noise=spec.process_noise,
+                sensor_noise=spec.sensor_noise,
+                horizon=spec.horizon,
+                bryson=self.bryson(spec),
+                soft_outputs=spec.soft_outputs or None,
+                slack_weight=spec.slack_weight,
+                sample_rate=rate,
+                solver=spec.solver,
+            )
+
+        def one(v: float):
+            if spec.type == "lqr":
+                return lqr(
+                    self.design(v, filtered=False),
+                    self.controls,
+                    bryson=self.bryson(spec),
+                    sample_rate=rate,
+                    state_map=self.plant_state_map(),
+                )
+            return lqg(
+                self.design(v),
+                self.controls,
+                self.sensors,
+                process_noise=spec.process_noise,
+                sensor_noise=spec.sensor_noise,
+                bryson=self.bryson(spec),
+                sample_rate=rate,
+            )
+
+        if spec.schedule is None:
+            return one(speed)
+        if flutter_speed is None:
+            raise InputError(f"{spec.source}: schedule needs the open-loop flutter speed")
+        ctrl: GainSchedule = schedule(one, [f * flutter_speed for f in spec.schedule])
+        ctrl.design_speed = speed
+        return ctrl
+
+
+def check_spec_signals(
+    spec: ControllerSpec, controls: Sequence[str], sensors: Sequence[str], outputs: Sequence[str]
+) -> None:
+    """Check a controller spec's signal names against a loop's controls, sensors and outputs.
+
+    Raises
+    ------
+    InputError
+        Naming the spec's file, the key and the signal.
+    """
+    outputs = list(dict.fromkeys(list(sensors) + list(outputs)))
+    allowed = {
+        "weights.outputs": outputs,
+        "weights.inputs": list(controls),
+        "limits.magnitude": list(controls),
+        "limits.rate": list(controls),
+        "estimator.process_noise": ["gust"],
+        "estimator.sensor_noise": list(sensors),
+        "mpc.soft_outputs": outputs,
+    }
+    for key, names in spec.signals.items():
+        for n in names:
+            if n not in allowed[key]:
+                raise InputError(
+                    f"{spec.source}: {key}.{n}: not a signal of this loop; allowed {allowed[key]}"
+                )
+    if spec.type in ("lqr", "lqg", "mpc"):
+        missing = [c for c in controls if c not in spec.bryson_inputs]
+        if missing:
+            raise InputError(f"{spec.source}: weights.inputs: give an allowed value for {missing}")
+    if spec.type in ("lqg", "mpc"):
+        missing = [s for s in sensors if s not in spec.sensor_noise]
+        if missing:
+            raise InputError(
+                f"{spec.source}: estimator.sensor_noise: give a variance for {missing}"
+            )

@@ -1,0 +1,79 @@
+"""How to design a flutter-suppression controller (read from a controller file by
+:mod:`aeroservo.files.controller_file`): type, Bryson weights, limits, estimator noise, MPC
+settings and an optional gain schedule.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .plant import Limits
+
+__all__ = ["ControllerSpec", "CONTROLLER_TYPES"]
+
+
+CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc")
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """How to design a controller.
+
+    Attributes
+    ----------
+    type : str
+        ``"none"`` (open loop), ``"lqr"`` (full-state feedback), ``"lqg"`` (Kalman filter on
+        the sensors + LQR) or ``"mpc"`` (constrained MPC, casadi, Kalman filter).
+    name : str
+    bryson_outputs, bryson_inputs : dict
+        Allowed output and control values (Bryson's rule), in the signals' units.
+    state_weight : float
+        Small regularizing weight on all states (relative).
+    limits : Limits
+        Actuator magnitude [signal unit] and rate [signal unit / s] limits, applied in every
+        simulation and used by MPC.
+    process_noise : dict
+        Variance of each disturbance input, e.g. ``{"gust": 1.0}`` [(m/s)^2] (LQG, MPC).
+    sensor_noise : dict
+        Variance of each sensor [unit^2] (LQG, MPC).
+    horizon : int
+        MPC horizon [samples].
+    solver : str
+        casadi conic solver of the MPC QP.
+    soft_outputs : dict
+        MPC soft output limits (slack variables; never infeasible).
+    slack_weight : float
+        Relative weight of the squared slacks.
+    schedule : tuple of float or None
+        Gain-schedule design speeds as multiples of the open-loop flutter speed (LQR, LQG).
+    source : str
+        File the spec was read from.
+    """
+
+    type: str
+    name: str = ""
+    bryson_outputs: dict = field(default_factory=dict)
+    bryson_inputs: dict = field(default_factory=dict)
+    state_weight: float = 1e-8
+    limits: Limits = field(default_factory=Limits)
+    process_noise: dict = field(default_factory=dict)
+    sensor_noise: dict = field(default_factory=dict)
+    horizon: int = 20
+    solver: str = "daqp"
+    soft_outputs: dict = field(default_factory=dict)
+    slack_weight: float = 1e4
+    schedule: tuple | None = None
+    source: str = "<dict>"
+
+    @property
+    def signals(self) -> dict:
+        """Every signal name the spec refers to, by the key that names it."""
+        return {
+            "weights.outputs": list(self.bryson_outputs),
+            "weights.inputs": list(self.bryson_inputs),
+            "limits.magnitude": list(self.limits.magnitude),
+            "limits.rate": list(self.limits.rate),
+            "estimator.process_noise": list(self.process_noise),
+            "estimator.sensor_noise": list(self.sensor_noise),
+            "mpc.soft_outputs": list(self.soft_outputs),
+        }

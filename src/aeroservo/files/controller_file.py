@@ -1,0 +1,110 @@
+"""Controller specification files (``controllers/*.toml``, schema in ``docs/scenarios.md``).
+
+A controller file describes *how* to design a flutter-suppression controller, independently of
+the wing: the type (``lqr``, ``lqg``, ``mpc`` or ``none`` for the open loop), Bryson weights,
+actuator limits, estimator noise levels, MPC settings and an optional gain schedule. Scenarios
+refer to it by path, so one wing can be tried with many controllers. Signal names are checked
+against the wing's model when a scenario is resolved.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..design.mpc import SOLVERS
+from ..design.plant import Limits
+from ..design.spec import CONTROLLER_TYPES, ControllerSpec
+from .toml_tables import Table, check_integers, one_line_errors, read_toml
+
+__all__ = ["load_controller", "controller_from_dict"]
+
+
+TOP_KEYS = ("type", "name", "description", "weights", "limits", "estimator", "mpc", "schedule")
+
+
+def controller_from_dict(data: object, file: str = "<dict>") -> ControllerSpec:
+    """Build a :class:`ControllerSpec` from a parsed controller file."""
+    with one_line_errors():
+        return _controller_from_dict(data, file)
+
+
+def _controller_from_dict(data: object, file: str) -> ControllerSpec:
+    check_integers(data, file)
+    top = Table(data, "", file).check_keys(("type",), TOP_KEYS[1:])
+    kind = top.string("type", choices=CONTROLLER_TYPES, required=True)
+    top.string("description")
+    kw: dict = {"type": kind, "name": top.string("name", "") or kind, "source": file}
+    needs = {
+        "none": (),
+        "lqr": ("weights",),
+        "lqg": ("weights", "estimator"),
+        "mpc": ("weights", "estimator", "limits"),
+    }[kind]
+    allowed = {
+        "none": ("limits",),
+        "lqr": ("weights", "limits", "schedule"),
+        "lqg": ("weights", "estimator", "limits", "schedule"),
+        "mpc": ("weights", "estimator", "limits", "mpc"),
+    }[kind]
+    for key in TOP_KEYS[3:]:
+        if top.has(key) and key not in allowed:
+            top.fail(key, top.data[key], f"not used by a controller of type {kind!r}")
+        if key in needs and not top.has(key):
+            raise_missing(top, key, kind)
+
+    w = top.table("weights").check_keys(
+        ("outputs", "inputs") if top.has("weights") else (), ("state_weight",)
+    )
+    kw["bryson_outputs"] = w.number_map("outputs")
+    kw["bryson_inputs"] = w.number_map("inputs")
+    if top.has("weights") and (not kw["bryson_outputs"] or not kw["bryson_inputs"]):
+        key = "outputs" if not kw["bryson_outputs"] else "inputs"
+        w.fail(key, w.data[key], "give at least one allowed value")
+    kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0)
+
+    lim = top.table("limits").check_keys((), ("magnitude", "rate"))
+    kw["limits"] = Limits(magnitude=lim.number_map("magnitude"), rate=lim.number_map("rate"))
+    if kind == "mpc":
+        for k in ("magnitude", "rate"):
+            if not getattr(kw["limits"], k):
+                raise_missing(lim, k, kind)
+        for c in kw["bryson_inputs"]:
+            for k in ("magnitude", "rate"):
+                if c not in getattr(kw["limits"], k):
+                    lim.fail(k, lim.data[k], f"MPC needs a {k} limit for control {c!r}")
+
+    est = top.table("estimator").check_keys(
+        ("process_noise", "sensor_noise") if top.has("estimator") else ()
+    )
+    kw["process_noise"] = est.number_map("process_noise")
+    kw["sensor_noise"] = est.number_map("sensor_noise")
+    for k in ("process_noise", "sensor_noise"):
+        if top.has("estimator") and not kw[k]:
+            est.fail(k, est.data[k], "give at least one variance")
+
+    m = top.table("mpc").check_keys((), ("horizon", "solver", "soft_outputs", "slack_weight"))
+    kw["horizon"] = m.integer("horizon", 20, lo=1, hi=500)
+    kw["solver"] = m.string("solver", "daqp", choices=sorted(SOLVERS))
+    kw["soft_outputs"] = m.number_map("soft_outputs")
+    kw["slack_weight"] = m.number("slack_weight", 1e4, lo=0.0, lo_open=True)
+
+    if top.has("schedule"):
+        s = top.table("schedule").check_keys(("speed_factors",))
+        kw["schedule"] = tuple(s.numbers("speed_factors", lo=0.0, lo_open=True, increasing=True))
+        if len(kw["schedule"]) < 2:
+            s.fail("speed_factors", s.data["speed_factors"], "give at least two speeds")
+    return ControllerSpec(**kw)
+
+
+def raise_missing(table: Table, key: str, kind: str):
+    from ..errors import InputError
+
+    raise InputError(
+        f"{table.file}: {table.key_name(key)}: missing; a controller of type {kind!r} needs it"
+    )
+
+
+def load_controller(path: str | Path) -> ControllerSpec:
+    """Read a controller file (``controllers/*.toml``)."""
+    with one_line_errors():
+        return controller_from_dict(read_toml(path), str(path))

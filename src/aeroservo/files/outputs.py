@@ -1,0 +1,85 @@
+"""The outputs of a scenario run, written as one set (:func:`write_run`).
+
+A flutter run writes ``<result>.json`` and ``<result>_vg.png``; a simulation writes
+``<result>.npz`` (:mod:`aeroservo.files.results`), ``<result>.png``, ``<result>_boundary.png``
+when the closed-loop boundary was computed, and ``<result>.json``; a trade study writes
+``summary.json``, ``heatmap.png`` and ``pareto.png`` into its folder (next to its case store,
+CSV and NetCDF). Every file of a run is renamed into place only when all of them have been
+written (:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..atomic import atomic_write_set, figure_writer
+from ..studies.runs import Run
+from .results import json_text, result_writer
+
+__all__ = ["write_run"]
+
+
+def _text_writer(text: str):
+    return lambda p: p.write_text(text, encoding="utf-8")
+
+
+def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
+    """Write the summary, result file and figures of a run; returns ``{kind: path}``.
+
+    The paths are also recorded in ``run.summary["files"]`` (and so in the JSON summary).
+
+    Parameters
+    ----------
+    run : Run
+        From :func:`aeroservo.studies.runs.run_scenario`.
+    out_dir : str or Path
+        Output folder (must exist); a trade study writes into its own folder ``run.folder``.
+    """
+    out = Path(out_dir)
+    sc = run.scenario
+    summary = run.summary
+    items: list = []
+    files: dict[str, str] = {}
+    plots = sc.plots
+
+    def add(kind: str, path: Path, writer) -> None:
+        files[kind] = str(path)
+        items.append((path, writer))
+
+    if sc.kind == "flutter":
+        json_path = out / f"{sc.result}.json"
+        files["summary"] = str(json_path)
+        if plots:
+            from ..plots import plot_vg
+
+            png = out / f"{sc.result}_vg.png"
+            add("vg_plot", png, figure_writer(plot_vg(run.flutter, title=run.title), png, dpi=120))
+    elif sc.kind == "simulate":
+        npz = out / f"{sc.result}.npz"
+        add("result", npz, result_writer(run.simulation, dict(summary)))
+        if plots:
+            png = out / f"{sc.result}.png"
+            add("plot", png, figure_writer(run.simulation.plot(), png, dpi=120))
+            if run.boundary is not None:
+                png = out / f"{sc.result}_boundary.png"
+                fig = run.boundary.plot(open_loop=run.flutter)
+                add("boundary_plot", png, figure_writer(fig, png, dpi=120))
+        json_path = out / f"{sc.result}.json"
+        files["summary"] = str(json_path)
+    else:
+        res, folder = run.trade, run.folder
+        files["csv"], files["netcdf"] = str(res.csv_path), str(res.netcdf_path)
+        ok = res.table[res.table["status"] == "ok"]
+        if plots and len(ok):
+            names = list(res.parameters)
+            if len(names) >= 2:
+                png = folder / "heatmap.png"
+                fig = res.heatmap("suppression_margin", names[0], names[1])
+                add("heatmap", png, figure_writer(fig, png, dpi=120))
+            png = folder / "pareto.png"
+            add("pareto", png, figure_writer(res.pareto(), png, dpi=120))
+        json_path = folder / "summary.json"
+    summary["files"] = files
+    items.append((json_path, _text_writer(json_text(summary))))
+    atomic_write_set(items)
+    return files

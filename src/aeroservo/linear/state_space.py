@@ -1,0 +1,359 @@
+"""Linear state-space export for control design (python-control ``StateSpace``, named signals).
+
+The model ``x' = A(V) x + B(V) u``, ``y = C(V) x + D(V) u`` is polynomial in the airspeed V:
+every coefficient matrix is computed once per (model, density, inputs, outputs) by
+:class:`StateSpaceBuilder`; a model at a speed, or a family over a speed grid, is then a few
+matrix additions.
+
+State vector (names in ``sys.state_labels``): structural unknowns q, their rates, the Wagner lag
+states ``z<i>_<node>``, the Kussner gust states ``g<i>_b<group>`` (gust model ``"kussner"``)
+and the servo states ``<surface>_servo[_rate]`` (commanded-deflection inputs with servo
+dynamics). Signals, units and sign conventions: :mod:`aeroservo.linear.signals` and
+``docs/statespace.md``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._threads import blas_limited
+from ..aero.indicial import IndicialSet, kussner_set
+from ..errors import InputError, check_number
+from ..system.first_order import first_order
+from .servo import Servo, servos_of
+from .signals import (
+    Sensor,
+    actuator_rows,
+    hinge_moment_vector,
+    output_units,
+    resolve_inputs,
+    resolve_outputs,
+    sensor_row,
+    surface_mean_row,
+    surface_unit,
+)
+
+__all__ = ["Servo", "StateSpaceBuilder"]
+
+
+class _Poly:
+    """Matrix polynomial ``sum_k V^k c[k]``."""
+
+    __slots__ = ("c",)
+
+    def __init__(self, c: np.ndarray):
+        self.c = np.asarray(c, dtype=float)
+
+    @classmethod
+    def const(cls, m: np.ndarray) -> _Poly:
+        return cls(np.asarray(m, dtype=float)[None])
+
+    def __add__(self, other: _Poly) -> _Poly:
+        k = max(self.c.shape[0], other.c.shape[0])
+        out = np.zeros((k,) + self.c.shape[1:])
+        out[: self.c.shape[0]] += self.c
+        out[: other.c.shape[0]] += other.c
+        return _Poly(out)
+
+    def __matmul__(self, other: _Poly) -> _Poly:
+        k = self.c.shape[0] + other.c.shape[0] - 1
+        out = np.zeros((k, self.c.shape[1], other.c.shape[2]))
+        for i in range(self.c.shape[0]):
+            for j in range(other.c.shape[0]):
+                out[i + j] += self.c[i] @ other.c[j]
+        return _Poly(out)
+
+    def left(self, m: np.ndarray) -> _Poly:
+        """``m @ self`` for a constant matrix m."""
+        return _Poly(np.einsum("ij,kjl->kil", m, self.c))
+
+    def __call__(self, v: float) -> np.ndarray:
+        out = self.c[-1].copy()
+        for k in range(self.c.shape[0] - 2, -1, -1):
+            out *= v
+            out += self.c[k]
+        return out
+
+
+def _dense(m) -> np.ndarray:
+    return m.toarray() if sp.issparse(m) else np.asarray(m, dtype=float)
+
+
+class StateSpaceBuilder:
+    """Speed-independent state-space coefficients of a wing model; models at any speed are cheap.
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    density : float
+        Air density [kg/m^3].
+    inputs : sequence of str, optional
+        Input names (default: every surface's ``<s>_hinge_moment`` and ``gust``).
+    outputs : sequence of str or Sensor, optional
+        Output names or sensors (default ``tip_le_accel``, ``tip_te_accel``, ``tip_twist``).
+    servo : Servo or dict of Servo, optional
+        Servo dynamics of commanded-deflection inputs (per surface name, or one for all);
+        default ideal (order 0).
+    gust : {"kussner", "upwash"}
+        ``"kussner"``: the gust penetrates the chord; Kussner lag states (one set per distinct
+        semichord; uniform spanwise gust). ``"upwash"``: the chordwise travel time is neglected
+        and the gust acts as a uniform upwash through the Wagner lag states (no extra states).
+    kussner : str, mapping or IndicialSet
+        Kussner approximation (default Sears & Sparks).
+    n_modes : int, optional
+        Modal truncation of the structure: keep this many in-vacuo modes (the lag states stay
+        complete and consistent with the projected downwash). Default: no truncation.
+    """
+
+    @blas_limited
+    def __init__(
+        self,
+        model,
+        density: float,
+        inputs: Sequence[str] | None = None,
+        outputs: Sequence[str | Sensor] | None = None,
+        *,
+        servo: Servo | dict | None = None,
+        gust: str = "kussner",
+        kussner: object = "sears_sparks",
+        n_modes: int | None = None,
+    ):
+        self.model = model
+        self.density = rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+        if gust not in ("kussner", "upwash"):
+            raise InputError(f"gust = {gust!r}: allowed values are 'kussner' and 'upwash'")
+        self.gust = gust
+        self.kussner: IndicialSet = kussner_set(kussner)
+        wing = model.wing
+        self.inputs = resolve_inputs(wing, inputs)
+        n_avail = model.n_dofs
+        self.outputs = resolve_outputs(model, outputs, n_avail)
+        self.servos = servos_of(wing, servo, self.inputs)
+
+        # structural basis: full FE unknowns or a modal truncation
+        am = model.matrices
+        n_need = max([n_modes or 0] + [o.index + 1 for o in self.outputs if o.kind == "modal"])
+        modes = model.natural_modes(n_need) if n_need else None
+        if n_modes is not None:
+            n_modes = min(int(n_modes), n_avail)
+            am = am.project(modes.shapes[:, :n_modes])
+            basis = modes.shapes[:, :n_modes]
+        else:
+            basis = None
+        self.n_modes = n_modes
+        self.basis = basis
+
+        def vec(v: np.ndarray) -> np.ndarray:  # generalized force / row in the used unknowns
+            return v if basis is None else basis.T @ v
+
+        system = first_order(am, model.wagner, rho, model.semichord)
+        self.system = system
+        n_q = am.n_q
+        T = model.wagner.n_terms
+        n_z = T * am.n_nodes
+        groups = am.circ_groups
+        kus = self.kussner
+        has_gust = any(d.kind == "gust" for d in self.inputs)
+        n_g = len(groups) * kus.n_terms if (gust == "kussner" and has_gust) else 0
+        n_s = sum(sv.n_states for sv in self.servos.values())
+        n = 2 * n_q + n_z + n_g + n_s
+        m = len(self.inputs)
+        iq, iv = slice(0, n_q), slice(n_q, 2 * n_q)
+        iz = slice(2 * n_q, 2 * n_q + n_z)
+        ig = slice(iz.stop, iz.stop + n_g)
+        self.n_states = n
+
+        A = np.zeros((3, n, n))
+        B = np.zeros((2, n, m))
+        n0 = 2 * n_q + n_z
+        for k, a in enumerate((system.A0, system.A1, system.A2)):
+            A[k, :n0, :n0] = _dense(a)
+
+        # aerodynamic generalized forces (without apparent mass) on the free and root unknowns
+        wag = model.wagner
+        scale = 1.0 - sum(wag.A)
+        ab = np.asarray(wag.A) * np.asarray(wag.b)
+        rt = am.root
+        Fa = np.zeros((3, n_q, n))
+        Fa[:, :, :n0] = A[:, iv, :n0]
+        Fa[0, :, iq] += _dense(am.Ks)
+        Fr = np.zeros((3, 3, n))
+        Fr[2, :, iq] = -rho * _dense(rt.Knc - scale * rt.Pq)
+        Fr[1, :, iv] = -rho * _dense(rt.Cnc - scale * rt.Pd)
+        Fr[2, :, iz] = rho * np.kron(_dense(rt.W1), ab[None, :])
+        Fu = np.zeros((2, n_q, m))
+        Fru = np.zeros((2, 3, m))
+
+        # gust
+        col = {d.name: j for j, d in enumerate(self.inputs)}
+        g_states = []
+        if "gust" in col:
+            j = col["gust"]
+            if gust == "kussner":
+                ka, kb = np.asarray(kus.A), np.asarray(kus.b)
+                for gi, g in enumerate(groups):
+                    for t in range(kus.n_terms):
+                        s = ig.start + gi * kus.n_terms + t
+                        A[1, s, s] = -kb[t] / g.b
+                        B[0, s, j] = 1.0
+                        Fa[2, :, s] = rho * ka[t] * kb[t] * g.Gw
+                        Fr[2, :, s] = rho * ka[t] * kb[t] * rt.circ_groups[gi].Gw
+                        g_states.append(f"g{t + 1}_b{gi}")
+                direct = 1.0 - ka.sum()
+            else:
+                B[0, iz, j] = np.kron(np.asarray(am.Mz1.sum(axis=1)).ravel(), np.ones(T))
+                direct = scale
+            Fu[1, :, j] = rho * direct * sum(g.b * g.Gw for g in groups)
+            Fru[1, :, j] = rho * direct * sum(g.b * g.Gw for g in rt.circ_groups)
+
+        A[:, iv, :] = Fa
+        A[0, iv, iq] -= _dense(am.Ks)
+        B[:, iv, :] = Fu
+
+        # control inputs and servo states
+        s_next = ig.stop
+        servo_states: list[str] = []
+        self._servo_index: dict[int, int] = {}
+        for d in self.inputs:
+            j = col[d.name]
+            k = d.surface
+            if d.kind == "hinge_moment":
+                B[0, iv, j] += vec(hinge_moment_vector(model, k))
+            elif d.kind == "command":
+                force = vec(sum(ka * r for ka, r in actuator_rows(model, k)))
+                sv = self.servos[k]
+                name = model.wing.control_surfaces[k].name
+                if sv.order == 0:
+                    B[0, iv, j] += force
+                else:
+                    y = s_next
+                    self._servo_index[k] = y
+                    A[0, iv, y] += force
+                    w = sv.bandwidth
+                    if sv.order == 1:
+                        A[0, y, y] = -w
+                        B[0, y, j] = w
+                        servo_states.append(f"{name}_servo")
+                    else:
+                        A[0, y, y + 1] = 1.0
+                        A[0, y + 1, y] = -w * w
+                        A[0, y + 1, y + 1] = -2 * sv.damping * w
+                        B[0, y + 1, j] = w * w
+                        servo_states += [f"{name}_servo", f"{name}_servo_rate"]
+                    s_next += sv.order
+
+        # E^-1 applied once: A(V) = sum V^k Abar_k
+        einv = np.eye(n)
+        einv[:n0, :n0] = _block_inverse_dense(system, n0)
+        self._A = _Poly(A).left(einv)
+        self._B = _Poly(B).left(einv)
+        acc_x = _Poly(self._A.c[:, iv, :])  # qdd = acc_x x + acc_u u
+        acc_u = _Poly(self._B.c[:, iv, :])
+
+        # outputs: y = Cx x + Du u + Cacc qdd
+        p = len(self.outputs)
+        Cx = np.zeros((3, p, n))
+        Du = np.zeros((2, p, m))
+        Cacc = np.zeros((p, n_q))
+        mnc = _dense(am.Mnc)
+        for i, o in enumerate(self.outputs):
+            if o.kind == "sensor":
+                row = vec(sensor_row(model, o.sensor))
+                q = o.sensor.quantity
+                if q in ("displacement", "twist"):
+                    Cx[0, i, iq] = row
+                elif q in ("velocity", "twist_rate"):
+                    Cx[0, i, iv] = row
+                else:
+                    Cacc[i] = row
+            elif o.kind == "deflection":
+                Cx[0, i, iq] = vec(surface_mean_row(model, o.surface))
+            elif o.kind == "rate":
+                Cx[0, i, iv] = vec(surface_mean_row(model, o.surface))
+            elif o.kind == "modal":
+                Cx[0, i, iq] = vec(_dense(model.matrices.Ms) @ modes.shapes[:, o.index])
+            elif o.kind == "aero_hinge_moment":
+                e = vec(surface_unit(model, o.surface))
+                Cx[:, i, :] = np.einsum("j,kjl->kl", e, Fa)
+                Du[:, i, :] = np.einsum("j,kjl->kl", e, Fu)
+                Cacc[i] = -rho * (e @ mnc)
+            elif o.kind == "actuator_moment":
+                k = o.surface
+                for ka, r in actuator_rows(model, k):
+                    Cx[0, i, iq] -= ka * vec(r)
+                k_tot = sum(ka for ka, _ in actuator_rows(model, k))
+                for d in self.inputs:
+                    if d.surface != k:
+                        continue
+                    if d.kind == "hinge_moment":
+                        Du[0, i, col[d.name]] = 1.0
+                    elif d.kind == "command" and self.servos[k].order == 0:
+                        Du[0, i, col[d.name]] = k_tot
+                    elif d.kind == "command":
+                        Cx[0, i, self._servo_index[k]] = k_tot
+            elif o.kind == "root":
+                r = o.index
+                Cx[:, i, :] = Fr[:, r, :]
+                Cx[0, i, iq] -= _dense(rt.Ks)[r]
+                Du[:, i, :] = Fru[:, r, :]
+                Cacc[i] = -_dense(rt.Ms)[r] - rho * _dense(rt.Mnc)[r]
+        self._C = _Poly(Cx) + acc_x.left(Cacc)
+        self._D = _Poly(Du) + acc_u.left(Cacc)
+
+        self.state_labels = tuple(system.state_labels) + tuple(g_states) + tuple(servo_states)
+        self.input_labels = tuple(d.name for d in self.inputs)
+        self.output_labels = tuple(d.name for d in self.outputs)
+        self.units = {d.name: d.unit for d in self.inputs} | output_units(self.outputs)
+
+    def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` at ``speed`` [m/s]."""
+        v = check_number("speed", speed, unit="m/s", lo=0.0)
+        return self._A(v), self._B(v), self._C(v), self._D(v)
+
+    def at(self, speed: float):
+        """``control.StateSpace`` at ``speed`` [m/s], with named signals.
+
+        The returned object carries ``speed`` [m/s], ``density`` [kg/m^3] and
+        ``signal_units`` (dict) attributes.
+        """
+        import control
+
+        A, B, C, D = self.matrices(speed)
+        sys = control.StateSpace(
+            A,
+            B,
+            C,
+            D,
+            states=list(self.state_labels),
+            inputs=list(self.input_labels),
+            outputs=list(self.output_labels),
+            name=_system_name(self.model.wing.name, float(speed)),
+        )
+        _tag(sys, float(speed), self.density, self.units)
+        return sys
+
+    def family(self, speeds: Sequence[float]) -> list:
+        """Models at every speed of a grid [m/s] (no re-assembly)."""
+        return [self.at(v) for v in speeds]
+
+
+def _system_name(wing_name: str, speed: float) -> str:
+    """python-control system name (no dots allowed): e.g. ``goland_wing_V137p4``."""
+    slug = re.sub(r"\W+", "_", wing_name).strip("_").lower() or "wing"
+    return f"{slug}_V{speed:.6g}".replace(".", "p").replace("-", "m")
+
+
+def _tag(sys, speed: float, density: float, units: dict) -> None:
+    sys.speed = speed
+    sys.density = density
+    sys.signal_units = dict(units)
+
+
+def _block_inverse_dense(system, n0: int) -> np.ndarray:
+    from ..system.first_order import _block_inverse
+
+    return _block_inverse(system.E, system.n_q)[:n0, :n0]

@@ -1,0 +1,184 @@
+"""Spanwise mesh of a wing and numbering of the nodal unknowns.
+
+Nodes are placed at every segment boundary and control-surface edge; the requested number of
+elements is shared among those intervals in proportion to their length (at least one each).
+
+Structural unknowns per node: ``w`` (bending displacement, up) [m], ``theta`` = dw/dx [rad],
+``phi`` (twist, nose-up) [rad], and one ``delta`` (flap rotation, trailing-edge down) [rad]
+per control surface covering the node. The root node is clamped (w = theta = phi = 0); flap
+rotations are never clamped. Unknowns are numbered node by node (small bandwidth).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, check_int
+from .wing import Wing
+
+__all__ = ["Mesh", "build_mesh", "LOCAL_DOFS"]
+
+LOCAL_DOFS = ("w_i", "theta_i", "w_j", "theta_j", "phi_i", "phi_j", "delta_i", "delta_j")
+"""Order of the 8 structural unknowns of one element (Hermite, linear twist, linear flap)."""
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Nodes, elements and unknown numbering of a wing stick model.
+
+    Attributes
+    ----------
+    nodes : ndarray (n_nodes,)
+        Spanwise stations [m].
+    segment : ndarray (n_elements,) of int
+        Index of the wing segment each element lies in.
+    surface : ndarray (n_elements,) of int
+        Index of the control surface on each element, -1 where there is none.
+    element_dofs : ndarray (n_elements, 8) of int
+        Global structural unknown of each local unknown (order ``LOCAL_DOFS``), -1 if removed
+        (clamped root, or no flap on the element).
+    dof_w, dof_theta, dof_phi : ndarray (n_nodes,) of int
+        Global unknown per node, -1 at the clamped root.
+    dof_delta : ndarray (n_surfaces, n_nodes) of int
+        Flap unknown per surface and node, -1 where the surface is absent.
+    dof_labels : tuple of str
+        Name of each structural unknown, e.g. ``"w_3"``, ``"delta_aileron_7"``.
+    """
+
+    nodes: np.ndarray
+    segment: np.ndarray
+    surface: np.ndarray
+    element_dofs: np.ndarray
+    dof_w: np.ndarray
+    dof_theta: np.ndarray
+    dof_phi: np.ndarray
+    dof_delta: np.ndarray
+    dof_labels: tuple[str, ...]
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.size)
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.nodes.size - 1)
+
+    @property
+    def n_dofs(self) -> int:
+        """Number of structural unknowns after the root clamp."""
+        return len(self.dof_labels)
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """Element lengths [m]."""
+        return np.diff(self.nodes)
+
+    def locate(self, x: float) -> tuple[int, float]:
+        """Element index and local coordinate xi in [0, 1] of station ``x`` [m]."""
+        span = self.nodes[-1]
+        if not (0.0 <= x <= span * (1 + 1e-12)):
+            raise InputError(
+                f"station = {x:g}: outside the wing, allowed range is [0, {span:g}] [m]"
+            )
+        e = int(np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.n_elements - 1))
+        xi = (x - self.nodes[e]) / (self.nodes[e + 1] - self.nodes[e])
+        return e, float(np.clip(xi, 0.0, 1.0))
+
+
+def _breakpoints(wing: Wing) -> np.ndarray:
+    pts = [0.0, wing.span]
+    pts += [s.end for s in wing.segments]
+    for cs in wing.control_surfaces:
+        pts += [cs.start, cs.end]
+    pts = np.unique(np.asarray(pts))
+    keep = np.r_[True, np.diff(pts) > 1e-9 * wing.span]
+    return pts[keep]
+
+
+def _allocate(lengths: np.ndarray, n: int) -> np.ndarray:
+    """Share ``n`` elements among intervals: at least one each, sizes as even as possible."""
+    counts = np.maximum(1, np.floor(n * lengths / lengths.sum()).astype(int))
+    while counts.sum() < n:
+        counts[np.argmax(lengths / counts)] += 1
+    while counts.sum() > n:
+        ratio = np.where(counts > 1, lengths / counts, np.inf)
+        counts[np.argmin(ratio)] -= 1
+    return counts
+
+
+def build_mesh(wing: Wing, n_elements: int) -> Mesh:
+    """Mesh a wing with ``n_elements`` beam elements.
+
+    Parameters
+    ----------
+    wing : Wing
+        The wing.
+    n_elements : int
+        Total number of elements; at least one per interval between segment boundaries and
+        control-surface edges.
+
+    Returns
+    -------
+    Mesh
+    """
+    n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
+    bp = _breakpoints(wing)
+    if n_elements < bp.size - 1:
+        raise InputError(
+            f"n_elements = {n_elements}: at least {bp.size - 1} are needed to put nodes at "
+            "every segment boundary and control-surface edge"
+        )
+    counts = _allocate(np.diff(bp), n_elements)
+    nodes = np.concatenate(
+        [np.linspace(bp[i], bp[i + 1], counts[i] + 1)[:-1] for i in range(bp.size - 1)] + [bp[-1:]]
+    )
+    mid = 0.5 * (nodes[:-1] + nodes[1:])
+    seg_ends = np.array([s.end for s in wing.segments])
+    segment = np.searchsorted(seg_ends, mid)
+    surface = np.full(mid.size, -1)
+    for k, cs in enumerate(wing.control_surfaces):
+        surface[(mid > cs.start) & (mid < cs.end)] = k
+
+    n_nodes = nodes.size
+    n_surf = len(wing.control_surfaces)
+    tol = 1e-9 * wing.span
+    dof_w = np.full(n_nodes, -1)
+    dof_theta = np.full(n_nodes, -1)
+    dof_phi = np.full(n_nodes, -1)
+    dof_delta = np.full((n_surf, n_nodes), -1)
+    labels: list[str] = []
+    for i, x in enumerate(nodes):
+        if i > 0:
+            for arr, name in ((dof_w, "w"), (dof_theta, "theta"), (dof_phi, "phi")):
+                arr[i] = len(labels)
+                labels.append(f"{name}_{i}")
+        for k, cs in enumerate(wing.control_surfaces):
+            if cs.start - tol <= x <= cs.end + tol:
+                dof_delta[k, i] = len(labels)
+                labels.append(f"delta_{cs.name}_{i}")
+
+    n_el = n_nodes - 1
+    el = np.arange(n_el)
+    edofs = np.full((n_el, 8), -1)
+    edofs[:, 0] = dof_w[el]
+    edofs[:, 1] = dof_theta[el]
+    edofs[:, 2] = dof_w[el + 1]
+    edofs[:, 3] = dof_theta[el + 1]
+    edofs[:, 4] = dof_phi[el]
+    edofs[:, 5] = dof_phi[el + 1]
+    has = surface >= 0
+    edofs[has, 6] = dof_delta[surface[has], el[has]]
+    edofs[has, 7] = dof_delta[surface[has], el[has] + 1]
+    return Mesh(
+        nodes=nodes,
+        segment=segment,
+        surface=surface,
+        element_dofs=edofs,
+        dof_w=dof_w,
+        dof_theta=dof_theta,
+        dof_phi=dof_phi,
+        dof_delta=dof_delta,
+        dof_labels=tuple(labels),
+    )

@@ -1,0 +1,273 @@
+"""Wing description: spanwise segments, control surfaces and actuators (SI units).
+
+Every quantity follows ``docs/conventions.md``: x spanwise from the root, y aft, z up;
+``a`` and ``hinge`` in semichords aft of mid-chord; ``x_alpha`` = (CG - EA)/b, positive aft.
+Section properties (``mass``, ``x_alpha``, ``inertia``) are those of the *whole* section,
+control surface included; a control surface adds its own static moment and inertia about
+the hinge, which couple the flap rotation to the wing motion.
+
+All classes validate on construction and raise :class:`~aeroservo.errors.InputError` with the
+field, the value and the allowed range.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, check_number
+
+__all__ = ["Segment", "Actuator", "ControlSurface", "Wing"]
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A spanwise piece of wing with constant cross-section properties.
+
+    Parameters
+    ----------
+    start, end : float
+        Spanwise stations of the inboard and outboard ends [m], measured from the root.
+    semichord : float
+        Semichord b [m].
+    a : float
+        Elastic-axis position in semichords aft of mid-chord [-] (-1 leading edge, +1 trailing
+        edge).
+    mass : float
+        Mass per unit length m [kg/m] (whole section, control surface included).
+    x_alpha : float
+        Centre-of-gravity offset (CG - EA)/b [-], positive when the CG is aft of the EA.
+    inertia : float
+        Polar mass moment of inertia per unit length about the elastic axis I_alpha [kg m].
+    EI : float
+        Flapwise bending stiffness [N m^2].
+    GJ : float
+        Torsional stiffness [N m^2].
+    """
+
+    start: float
+    end: float
+    semichord: float
+    a: float
+    mass: float
+    x_alpha: float
+    inertia: float
+    EI: float
+    GJ: float
+    name: str = "segment"
+
+    def __post_init__(self) -> None:
+        n = self.name
+        check_number(f"{n}.start", self.start, unit="m", lo=0.0)
+        check_number(f"{n}.end", self.end, unit="m", lo=self.start, lo_open=True)
+        check_number(f"{n}.semichord", self.semichord, unit="m", lo=0.0, lo_open=True)
+        check_number(f"{n}.a", self.a, lo=-1.0, hi=1.0)
+        check_number(f"{n}.mass", self.mass, unit="kg/m", lo=0.0, lo_open=True)
+        check_number(f"{n}.x_alpha", self.x_alpha, lo=-1.0 - self.a, hi=1.0 - self.a)
+        s_alpha = self.mass * self.x_alpha * self.semichord
+        i_min = s_alpha**2 / self.mass
+        check_number(f"{n}.inertia", self.inertia, unit="kg m", lo=i_min, lo_open=True)
+        check_number(f"{n}.EI", self.EI, unit="N m^2", lo=0.0, lo_open=True)
+        check_number(f"{n}.GJ", self.GJ, unit="N m^2", lo=0.0, lo_open=True)
+
+    @property
+    def static_moment(self) -> float:
+        """Static unbalance S_alpha = m x_alpha b about the elastic axis [kg m/m]."""
+        return self.mass * self.x_alpha * self.semichord
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """A point rotational spring between wing and control surface (the actuator).
+
+    Parameters
+    ----------
+    station : float
+        Spanwise position [m]; must lie on its control surface (need not be a mesh node).
+    stiffness : float
+        Rotational stiffness k_act [N m/rad].
+    """
+
+    station: float
+    stiffness: float
+    name: str = "actuator"
+
+    def __post_init__(self) -> None:
+        check_number(f"{self.name}.station", self.station, unit="m", lo=0.0)
+        check_number(f"{self.name}.stiffness", self.stiffness, unit="N m/rad", lo=0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class ControlSurface:
+    """A trailing-edge control surface hinged to the wing over a span interval.
+
+    Parameters
+    ----------
+    name : str
+        Identifier used for inputs/outputs (e.g. ``"aileron"``).
+    start, end : float
+        Spanwise extent [m].
+    hinge : float
+        Hinge-line position c in semichords aft of mid-chord [-], in [-1, 1); not ahead of the
+        elastic axis.
+    static_moment : float
+        Flap static moment per unit length about the hinge S_beta [kg m/m], positive when the
+        flap CG is aft of the hinge.
+    inertia : float
+        Flap mass moment of inertia per unit length about the hinge I_beta [kg m].
+    GJ : float
+        Flap torsional stiffness G_f J_f [N m^2], acting on the spanwise gradient of the flap
+        rotation (the seed's diagonal stiffness operator).
+    hinge_stiffness : float
+        Distributed hinge stiffness k_delta per unit length [N m/rad per m].
+    actuators : tuple of Actuator
+        Point springs k_act at given stations (Dirac deltas in the stiffness).
+    """
+
+    name: str
+    start: float
+    end: float
+    hinge: float
+    static_moment: float
+    inertia: float
+    GJ: float = 0.0
+    hinge_stiffness: float = 0.0
+    actuators: tuple[Actuator, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise InputError(
+                f"control_surface.name = {self.name!r}: must be an identifier "
+                "(letters, digits, underscore; used in signal names)"
+            )
+        n = f"control_surface '{self.name}'"
+        object.__setattr__(self, "actuators", tuple(self.actuators))
+        check_number(f"{n}.start", self.start, unit="m", lo=0.0)
+        check_number(f"{n}.end", self.end, unit="m", lo=self.start, lo_open=True)
+        check_number(f"{n}.hinge", self.hinge, lo=-1.0, hi=1.0, hi_open=True)
+        check_number(f"{n}.static_moment", self.static_moment, unit="kg m/m")
+        check_number(f"{n}.inertia", self.inertia, unit="kg m", lo=0.0, lo_open=True)
+        check_number(f"{n}.GJ", self.GJ, unit="N m^2", lo=0.0)
+        check_number(f"{n}.hinge_stiffness", self.hinge_stiffness, unit="N m/rad/m", lo=0.0)
+        for i, act in enumerate(self.actuators):
+            if not isinstance(act, Actuator):
+                raise InputError(f"{n}.actuators[{i}] = {act!r}: expected an Actuator")
+            check_number(
+                f"{n}.actuators[{i}].station", act.station, unit="m", lo=self.start, hi=self.end
+            )
+        if self.hinge_stiffness == 0.0 and not self.actuators:
+            raise InputError(
+                f"{n}: hinge_stiffness = 0 and no actuators: the surface would float freely "
+                "(a zero-frequency rigid mode); give hinge_stiffness > 0 [N m/rad/m] or at "
+                "least one actuator"
+            )
+
+
+@dataclass(frozen=True)
+class Wing:
+    """A straight cantilever wing clamped at x = 0.
+
+    Parameters
+    ----------
+    span : float
+        Semi-span L [m].
+    segments : tuple of Segment
+        Consecutive segments covering [0, span] without gaps or overlaps.
+    control_surfaces : tuple of ControlSurface
+        Non-overlapping trailing-edge surfaces inside [0, span].
+    name : str
+        Label used in reports.
+    """
+
+    span: float
+    segments: tuple[Segment, ...]
+    control_surfaces: tuple[ControlSurface, ...] = field(default_factory=tuple)
+    name: str = "wing"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "segments", tuple(self.segments))
+        object.__setattr__(self, "control_surfaces", tuple(self.control_surfaces))
+        span = check_number("wing.span", self.span, unit="m", lo=0.0, lo_open=True)
+        tol = 1e-9 * span
+        if not self.segments:
+            raise InputError("wing.segments = []: at least one segment is required")
+        x = 0.0
+        for i, seg in enumerate(self.segments):
+            if not isinstance(seg, Segment):
+                raise InputError(f"wing.segments[{i}] = {seg!r}: expected a Segment")
+            if abs(seg.start - x) > tol:
+                raise InputError(
+                    f"wing.segments[{i}].start = {seg.start:g}: must equal the end of the "
+                    f"previous segment ({x:g} m); segments must tile [0, span] in order"
+                )
+            x = seg.end
+        if abs(x - span) > tol:
+            raise InputError(f"wing.segments[-1].end = {x:g}: must equal wing.span = {span:g} [m]")
+        names = set()
+        surfaces = sorted(self.control_surfaces, key=lambda s: s.start)
+        for i, cs in enumerate(surfaces):
+            if not isinstance(cs, ControlSurface):
+                raise InputError(f"wing.control_surfaces[{i}] = {cs!r}: expected a ControlSurface")
+            if cs.name in names:
+                raise InputError(f"control_surface.name = {cs.name!r}: duplicate name")
+            names.add(cs.name)
+            if cs.end > span + tol:
+                raise InputError(
+                    f"control_surface '{cs.name}'.end = {cs.end:g}: outside the wing, allowed "
+                    f"range is [0, {span:g}] [m]"
+                )
+            if i > 0 and cs.start < surfaces[i - 1].end - tol:
+                raise InputError(
+                    f"control_surface '{cs.name}'.start = {cs.start:g}: overlaps "
+                    f"'{surfaces[i - 1].name}' which ends at {surfaces[i - 1].end:g} [m]"
+                )
+            for seg in self.segments:
+                if seg.end > cs.start + tol and seg.start < cs.end - tol:
+                    _check_flap_section(seg, cs)
+
+    def segment_at(self, x: float) -> Segment:
+        """Segment containing station ``x`` [m] (the inboard one at a boundary)."""
+        for seg in self.segments:
+            if x <= seg.end:
+                return seg
+        return self.segments[-1]
+
+    def surface(self, name: str) -> ControlSurface:
+        """Control surface by name; raises :class:`InputError` listing the known names."""
+        for cs in self.control_surfaces:
+            if cs.name == name:
+                return cs
+        known = [cs.name for cs in self.control_surfaces] or "none"
+        raise InputError(f"control surface {name!r}: unknown; this wing has {known}")
+
+    @property
+    def mass(self) -> float:
+        """Total wing mass [kg]."""
+        return float(sum(s.mass * (s.end - s.start) for s in self.segments))
+
+
+def _check_flap_section(seg: Segment, cs: ControlSurface) -> None:
+    """The section mass matrix with the flap coupling must be positive definite."""
+    b = seg.semichord
+    if cs.hinge < seg.a:
+        raise InputError(
+            f"control_surface '{cs.name}'.hinge = {cs.hinge:g}: must not lie ahead of the elastic "
+            f"axis of {seg.name} (a = {seg.a:g}) [semichords aft of mid-chord]"
+        )
+    y_h = b * (cs.hinge - seg.a)
+    s_a, s_b = seg.static_moment, cs.static_moment
+    m_sec = np.array(
+        [
+            [seg.mass, -s_a, -s_b],
+            [-s_a, seg.inertia, cs.inertia + y_h * s_b],
+            [-s_b, cs.inertia + y_h * s_b, cs.inertia],
+        ]
+    )
+    if np.linalg.eigvalsh(m_sec).min() <= 0.0:
+        raise InputError(
+            f"control_surface '{cs.name}': static_moment = {s_b:g} kg m/m and inertia = "
+            f"{cs.inertia:g} kg m are inconsistent with {seg.name} (mass {seg.mass:g} kg/m, "
+            f"inertia {seg.inertia:g} kg m): the section mass matrix is not positive definite; "
+            "the section properties must include the flap"
+        )

@@ -1,0 +1,312 @@
+"""Running scenarios: open-loop flutter, closed-loop simulation, trade study.
+
+Each ``run_*`` function computes and returns a :class:`Run`: the JSON-ready summary and the
+result objects behind it. Nothing is written here except a trade study's own case store (its
+folder, so that an interrupted study resumes); :func:`aeroservo.files.outputs.write_run` writes
+a run's summary, result file and figures as one set.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._threads import blas_limited
+from ..errors import InputError
+from .scenario import Scenario
+
+__all__ = ["Run", "run_scenario", "run_flutter", "run_simulation", "study_from_scenario"]
+
+
+@dataclass
+class Run:
+    """What one scenario run produced.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    summary : dict
+        JSON-ready summary (SI units; the ``units`` entry names them).
+    flutter : FlutterResult or None
+        Open-loop boundary (flutter scenarios; the plant's, for simulations).
+    simulation : SimulationResult or None
+        Time histories (simulate scenarios).
+    boundary : ClosedLoopBoundary or None
+        Closed-loop boundary, when the scenario asks for it.
+    trade : TradeResult or None
+        Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
+    folder : Path or None
+        Folder of a trade study's outputs.
+    title : str
+        Title of the figures.
+    """
+
+    scenario: Scenario
+    summary: dict
+    flutter: object = None
+    simulation: object = None
+    boundary: object = None
+    trade: object = None
+    folder: Path | None = None
+    title: str = ""
+
+
+def _progress_bar(total: float, desc: str, enabled: bool, unit: str = "m/s"):
+    """A tqdm bar advanced to an absolute position by the returned callback (or no-ops)."""
+    if not enabled:
+        return (lambda v: None), (lambda: None)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=round(total, 1), desc=desc, unit=unit, leave=False, dynamic_ncols=True)
+
+    def update(v: float) -> None:
+        bar.n = round(min(v, total), 1)
+        bar.refresh()
+
+    return update, bar.close
+
+
+@blas_limited
+def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
+    """Open-loop flutter and divergence of the scenario's wing (summary and V-g figure)."""
+    from ..stability.boundary import flutter_boundary
+
+    model = scenario.model()
+    update, close = _progress_bar(scenario.v_max or 300.0, "flutter sweep", progress)
+    try:
+        fr = flutter_boundary(model, scenario.density, v_max=scenario.v_max, progress=update)
+    finally:
+        close()
+    summary = {
+        "scenario": scenario.name,
+        "kind": "flutter",
+        "wing": scenario.wing.name,
+        "flutter_speed": fr.flutter_speed,
+        "flutter_frequency": fr.flutter_frequency,
+        "divergence_speed": fr.divergence_speed,
+        "n_states": fr.n_states,
+        "density": scenario.density,
+        "n_elements": model.n_elements,
+        "wagner": model.wagner.name,
+        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3"},
+    }
+    summary.update({k: v for k, v in fr.to_dict().items() if k not in summary})
+    if scenario.pk:
+        from ..stability.pk import pk_flutter
+
+        pk = pk_flutter(model, scenario.density, v_max=fr.v_max)
+        summary["pk_exact_theodorsen"] = {
+            "flutter_speed": pk.flutter_speed,
+            "flutter_frequency": pk.flutter_frequency,
+        }
+    title = f"{scenario.wing.name}: {model.n_elements} elements, {model.wagner.name}"
+    return Run(scenario, summary, flutter=fr, title=title)
+
+
+def _envelope_ratio(y: np.ndarray, frac: float = 0.2) -> float:
+    n = max(1, int(frac * y.size))
+    first = np.abs(y[:n]).max()
+    return float(np.abs(y[-n:]).max() / first) if first > 0 else float("nan")
+
+
+@blas_limited
+def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
+    """Closed-loop time simulation of a ``simulate`` scenario.
+
+    Returns
+    -------
+    Run
+        The time histories (``simulation``), the closed-loop boundary if asked, and a JSON-ready
+        summary (speeds [m/s], peaks and RMS in the signals' units, growth ratio of the
+        response, closed-loop flutter speed if asked).
+    """
+    from ..design.closed_loop import closed_loop_boundary
+    from ..simulate.march import simulate
+    from ..stability.boundary import flutter_boundary
+
+    if scenario.kind != "simulate":
+        raise InputError(f"{scenario.source}: scenario.kind = {scenario.kind!r}: not 'simulate'")
+    t0 = time.perf_counter()
+    model = scenario.model()
+    fr = flutter_boundary(model, scenario.density)
+    vf = fr.flutter_speed
+    if scenario.speed is not None:
+        speed = scenario.speed
+    elif vf is None:
+        raise ArithmeticError(
+            f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, but the "
+            f"wing has no flutter below {fr.v_max:.4g} m/s"
+        )
+    else:
+        speed = scenario.speed_factor * vf
+    loop = scenario.loop(model)
+    spec = scenario.controller
+    controller = loop.design_controller(spec, speed, scenario.sample_rate, vf)
+    plant = loop.plant(speed)
+    dist = scenario.disturbance
+    x0 = loop.initial_state(dist.initial_tip) if dist.initial_tip else None
+    noise = {k: np.sqrt(v) for k, v in scenario.sensor_noise.items()} or None
+    result = simulate(
+        plant,
+        controller.at(speed) if hasattr(controller, "at") else controller,
+        duration=scenario.duration,
+        x0=x0,
+        disturbance=dist.gust,
+        limits=spec.limits,
+        delay=scenario.delay,
+        sensor_noise=noise,
+        seed=scenario.seed,
+    )
+    summary: dict = {
+        "scenario": scenario.name,
+        "kind": "simulate",
+        "wing": scenario.wing.name,
+        "controller": spec.name,
+        "controller_type": spec.type,
+        "speed": speed,
+        "density": scenario.density,
+        "open_loop_flutter_speed": vf,
+        "open_loop_flutter_frequency": fr.flutter_frequency,
+        "speed_over_flutter_speed": None if vf is None else speed / vf,
+        "open_loop_unstable": bool(np.max(np.linalg.eigvals(np.asarray(plant.A)).real) > 0),
+        "duration": scenario.duration,
+        "sample_rate": scenario.sample_rate,
+        "n_plant_states": plant.nstates,
+        "signals": {},
+        "saturated_fraction": result.saturated_fraction(),
+        "units": dict(result.units),
+    }
+    for group in (result.outputs, result.applied):
+        for name, y in group.items():
+            summary["signals"][name] = {
+                "peak": float(np.abs(y).max()),
+                "rms": float(np.sqrt(np.mean(y**2))),
+                "growth": _envelope_ratio(y),
+            }
+    tip = next((n for n in result.outputs if n.startswith("tip_")), None)
+    if tip is not None:
+        g = summary["signals"][tip]["growth"]
+        summary["response"] = "decays" if g < 1 else "grows"
+    if result.status:
+        times = np.array([s["solve_time"] for s in result.status])
+        summary["mpc"] = {
+            "solve_time_median": float(np.median(times)),
+            "solve_time_p99": float(np.percentile(times, 99)),
+            "fallbacks": int(sum(s["fallback"] for s in result.status)),
+            "statuses": sorted({s["status"] for s in result.status}),
+        }
+    boundary = None
+    if scenario.closed_loop_boundary and spec.type in ("lqr", "lqg"):
+        v_top = scenario.v_max_factor * (vf or speed)
+        update, close = _progress_bar(v_top, "closed-loop sweep", progress)
+        try:
+            boundary = closed_loop_boundary(
+                loop.plant,
+                controller,
+                v_top,
+                n_grid=scenario.n_grid,
+                reference_speed=speed,
+                progress=update,
+            )
+        finally:
+            close()
+        summary["closed_loop"] = boundary.to_dict()
+        if vf is not None and boundary.flutter_speed is not None:
+            summary["closed_loop"]["flutter_speed_increase"] = boundary.flutter_speed / vf - 1
+    summary["wall_time"] = time.perf_counter() - t0
+    return Run(scenario, summary, flutter=fr, simulation=result, boundary=boundary)
+
+
+@blas_limited
+def run_scenario(
+    scenario: Scenario,
+    out_dir: Path | None = None,
+    *,
+    progress: bool = False,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    log: Callable[[str], None] | None = None,
+) -> dict:
+    """Run any scenario.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    out_dir : Path, optional
+        Output folder; a trade study keeps its case store in ``out_dir / scenario.result``
+        (required for trade studies, unused otherwise).
+    progress : bool
+        Progress bars on stderr.
+    scheduler, workers :
+        Dask scheduler address and local workers of a trade study.
+
+    Returns
+    -------
+    Run
+    """
+    if scenario.kind == "flutter":
+        return run_flutter(scenario, progress)
+    if scenario.kind == "simulate":
+        return run_simulation(scenario, progress)
+    from .trade.cluster import run_trade
+
+    if out_dir is None:
+        raise InputError("a trade study needs an output folder (--out)")
+    folder = out_dir / scenario.result
+    res = run_trade(
+        study_from_scenario(scenario),
+        folder,
+        scheduler=scheduler,
+        n_workers=workers or scenario.trade["workers"],
+        progress=progress,
+    )
+    summary = {
+        "scenario": scenario.name,
+        "kind": "trade",
+        "n_cases": res.n_cases,
+        "n_failed": res.n_failed,
+        "n_skipped": res.n_skipped,
+        "elapsed": res.elapsed,
+        "cases_per_second": (res.n_cases - res.n_skipped) / max(res.elapsed, 1e-9),
+    }
+    ok = res.table[res.table["status"] == "ok"]
+    if len(ok):
+        best = ok.loc[ok["suppression_margin"].idxmax()]
+        summary["best_case"] = {
+            k: (v.item() if hasattr(v, "item") else v) for k, v in best.items() if v == v
+        }
+    return Run(scenario, summary, trade=res, folder=folder)
+
+
+def study_from_scenario(scenario: Scenario):
+    """The :class:`~aeroservo.studies.trade.TradeStudy` of a ``trade`` scenario."""
+    from .trade.study import TradeStudy
+
+    t = scenario.trade
+    return TradeStudy(
+        base_wing=scenario.wing,
+        density=scenario.density,
+        elements=scenario.elements,
+        wagner=scenario.wagner,
+        controls=tuple(scenario.controls),
+        sensors=tuple(scenario.sensors),
+        outputs=tuple(scenario.outputs),
+        design_modes=scenario.design_modes,
+        sensor_filter=scenario.sensor_filter,
+        filter_order=scenario.filter_order,
+        gust_model=scenario.gust_model,
+        controller=t["controller"],
+        sample_rate=scenario.sample_rate,
+        parameters=dict(t["parameters"]),
+        speed_factor=t["speed_factor"],
+        gust_length=t["gust_length"],
+        gust_amplitude=t["gust_amplitude"],
+        gust_duration=t["gust_duration"],
+        v_max_factor=t["v_max_factor"],
+        n_grid=t["n_grid"],
+        name=scenario.result,
+    )

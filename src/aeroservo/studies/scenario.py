@@ -1,0 +1,115 @@
+"""A scenario: what to run on which wing (open-loop flutter, closed-loop simulation, trade study),
+with the flight condition, model options, signals, disturbance, controller and outputs.
+Read from a scenario file by :mod:`aeroservo.files.scenario_file`; run by
+:mod:`aeroservo.studies.runs`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..design.spec import ControllerSpec
+
+__all__ = ["Scenario", "Disturbance", "quick", "SCENARIO_KINDS"]
+
+
+SCENARIO_KINDS = ("flutter", "simulate", "trade")
+GUST_TYPES = ("none", "one_minus_cosine", "turbulence", "series")
+GUST_KEYS = {
+    "none": (),
+    "one_minus_cosine": ("length", "amplitude", "start"),
+    "turbulence": ("sigma", "scale", "model", "seed"),
+    "series": ("file",),
+}
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """Initial condition and gust of a simulation.
+
+    Attributes
+    ----------
+    initial_tip : float
+        Initial tip deflection [m] (static tip-load shape), 0 for none.
+    gust : object or None
+        A callable ``w(t, speed)`` [m/s] from :mod:`aeroservo.aero.gusts`, or None.
+    """
+
+    initial_tip: float = 0.0
+    gust: object = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (SI units). See ``docs/scenarios.md`` for every key."""
+
+    name: str
+    kind: str
+    source: str
+    wing: object
+    description: str = ""
+    wing_source: str = ""
+    density: float = 1.225
+    speed: float | None = None
+    speed_factor: float | None = None
+    elements: int = 10
+    wagner: object = "rt_jones"
+    design_modes: int | None = 8
+    gust_model: str = "kussner"
+    v_max: float | None = None
+    pk: bool = False
+    controls: tuple = ()
+    sensors: tuple = ()
+    outputs: tuple = ()
+    sensor_filter: float | None = 30.0
+    filter_order: int = 2
+    disturbance: Disturbance = field(default_factory=Disturbance)
+    controller: ControllerSpec | None = None
+    duration: float = 2.0
+    sample_rate: float = 1000.0
+    delay: bool = False
+    seed: int = 0
+    sensor_noise: dict = field(default_factory=dict)
+    closed_loop_boundary: bool = False
+    v_max_factor: float = 2.0
+    n_grid: int = 41
+    result: str = ""
+    plots: bool = True
+    trade: object = None
+
+    def model(self):
+        """The aeroelastic model of the scenario's wing and options."""
+        from ..system.aeroelastic import AeroelasticModel
+
+        return AeroelasticModel(self.wing, self.elements, self.wagner)
+
+    def loop(self, model=None):
+        """The :class:`~aeroservo.design.loop.ControlLoop` of a simulate scenario."""
+        from ..design.loop import ControlLoop
+
+        return ControlLoop(
+            model or self.model(),
+            self.density,
+            self.controls,
+            self.sensors,
+            self.outputs,
+            design_modes=self.design_modes,
+            sensor_filter=self.sensor_filter,
+            filter_order=self.filter_order,
+            gust=self.gust_model,
+        )
+
+
+def quick(s: Scenario) -> Scenario:
+    """Fast settings of a scenario for smoke tests: at most 0.5 s simulated, an 11-point
+    closed-loop grid, two values per trade parameter and a 0.3 s gust in trade studies."""
+    from dataclasses import replace
+
+    kw: dict = {"duration": min(s.duration, 0.5), "n_grid": min(s.n_grid, 11)}
+    if s.trade is not None:
+        t = dict(s.trade)
+        t["parameters"] = {k: v[:2] for k, v in t["parameters"].items()}
+        t["gust_duration"] = min(t["gust_duration"], 0.3)
+        t["n_grid"] = min(t["n_grid"], 11)
+        kw["trade"] = t
+    return replace(s, **kw)

@@ -1,0 +1,197 @@
+"""Results of a trade study: one table row per case and a labelled N-dimensional dataset."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import InputError
+from .plots import _heatmap, _pareto
+from .study import FORMAT, METRICS, PARAMETERS
+
+__all__ = ["TradeResult", "load_trade"]
+
+_TEXT = ("status", "failed_stage", "error")
+
+
+@dataclass
+class TradeResult:
+    """Results of a trade study.
+
+    Attributes
+    ----------
+    name : str
+    parameters : dict
+        ``{name: values}`` of the swept parameters (the dataset's dimensions).
+    table : pandas.DataFrame
+        One row per case, in grid order: ``case_id``, the parameters, ``status``,
+        ``failed_stage``, ``error`` and the metrics (NaN when unavailable).
+    dataset : xarray.Dataset
+        One dimension per parameter, one variable per metric (units in ``attrs``), plus
+        ``case_id``, ``status`` and ``error``.
+    csv_path, netcdf_path : Path or None
+    n_skipped : int
+        Cases already finished before this run.
+    n_failed : int
+        Cases that failed.
+    elapsed : float
+        Wall time of the run [s].
+    settings : dict
+        The study's fixed settings (:func:`study_settings`).
+    """
+
+    name: str
+    parameters: dict
+    table: object
+    dataset: object
+    settings: dict = field(default_factory=dict)
+    csv_path: Path | None = None
+    netcdf_path: Path | None = None
+    n_skipped: int = 0
+    elapsed: float = 0.0
+
+    @property
+    def n_cases(self) -> int:
+        return len(self.table)
+
+    @property
+    def n_failed(self) -> int:
+        return int((self.table["status"] != "ok").sum())
+
+    def __repr__(self) -> str:
+        dims = " x ".join(f"{k}[{len(v)}]" for k, v in self.parameters.items())
+        return (
+            f"TradeResult({self.name!r}: {dims} = {self.n_cases} cases, {self.n_failed} failed, "
+            f"{self.n_skipped} skipped, {self.elapsed:.1f} s)"
+        )
+
+    def heatmap(
+        self,
+        metric: str = "closed_loop_flutter_speed",
+        x: str | None = None,
+        y: str | None = None,
+        **fixed: float,
+    ):
+        """Heat map of a metric over two parameters.
+
+        Parameters
+        ----------
+        metric : str
+            A name of :data:`METRICS`.
+        x, y : str, optional
+            Swept parameters on the axes (default: the first two).
+        **fixed
+            The other parameters' positions: an ``int`` is an index into the parameter's
+            values, a ``float`` a value (the nearest one); default: the first value.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        return _heatmap(self.dataset, self.parameters, metric, x, y, fixed)
+
+    def pareto(self):
+        """Suppression margin versus peak hinge moment, the Pareto front highlighted.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        return _pareto(self.table, self.name)
+
+
+def _assemble(name: str, parameters: dict, rows: list[dict], settings: dict):
+    import pandas as pd
+    import xarray as xr
+
+    names = list(parameters)
+    cols = ["case_id", *names, *_TEXT, *METRICS]
+    table = pd.DataFrame([{c: r.get(c) for c in cols} for r in rows], columns=cols)
+    for m in METRICS:
+        table[m] = pd.to_numeric(table[m].astype(object).where(table[m].notna(), np.nan))
+        table[m] = table[m].astype(float)
+    for c in ("case_id", *_TEXT):
+        table[c] = table[c].where(table[c].notna(), "").astype(str)
+    shape = tuple(len(v) for v in parameters.values())
+    data_vars = {}
+    for m, (unit, desc) in METRICS.items():
+        data_vars[m] = (
+            names,
+            table[m].to_numpy().reshape(shape),
+            {"units": unit, "long_name": desc},
+        )
+    for c in ("case_id", *_TEXT):
+        arr = np.array(table[c].tolist(), dtype=object).reshape(shape)
+        data_vars[c] = (names, arr)
+    coords = {
+        k: (
+            k,
+            np.asarray(v, dtype=float),
+            {"units": PARAMETERS[k][0], "long_name": PARAMETERS[k][1]},
+        )
+        for k, v in parameters.items()
+    }
+    ds = xr.Dataset(
+        data_vars,
+        coords=coords,
+        attrs={
+            "title": f"aeroservo trade study {name!r}",
+            "study": name,
+            "format": FORMAT,
+            "settings": json.dumps(settings, sort_keys=True),
+        },
+    )
+    return TradeResult(
+        name=name, parameters=dict(parameters), table=table, dataset=ds, settings=settings
+    )
+
+
+def load_trade(out_dir: str | Path) -> TradeResult:
+    """Re-read a finished study from its folder (for re-plotting).
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The ``out_dir`` of :func:`run_trade`.
+
+    Returns
+    -------
+    TradeResult
+        Table from the CSV, dataset from the NetCDF file (``n_skipped`` = number of cases).
+    """
+    import pandas as pd
+    import xarray as xr
+
+    out = Path(out_dir)
+    try:
+        manifest = json.loads((out / "study.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise InputError(f"out_dir = {str(out)!r}: no readable study.json ({exc})") from None
+    if manifest.get("format") != FORMAT:
+        raise InputError(
+            f"{out / 'study.json'}: format = {manifest.get('format')!r}; expected {FORMAT!r}"
+        )
+    csv, nc = out / manifest["csv"], out / manifest["netcdf"]
+    for p in (csv, nc):
+        if not p.is_file():
+            raise InputError(f"{p}: missing; the study has not finished (run it again)")
+    table = pd.read_csv(csv, keep_default_na=False, na_values={m: ["", "NaN"] for m in METRICS})
+    for c in ("case_id", *_TEXT):
+        table[c] = table[c].astype(str)
+    with xr.open_dataset(nc, engine="scipy") as ds:
+        dataset = ds.load()
+    params = {k: tuple(float(x) for x in v) for k, v in manifest["parameters"].items()}
+    result = TradeResult(
+        name=manifest["name"],
+        parameters=params,
+        table=table,
+        dataset=dataset,
+        settings=manifest.get("settings", {}),
+        csv_path=csv,
+        netcdf_path=nc,
+        n_skipped=len(table),
+    )
+    return result

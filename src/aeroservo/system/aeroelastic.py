@@ -1,0 +1,167 @@
+"""The wing stick model: a wing, its mesh, and the speed-independent matrices built once."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..aero.indicial import IndicialSet, wagner_set
+from ..errors import InputError, check_int, check_number
+from ..structure.mesh import Mesh, build_mesh
+from ..structure.wing import Wing
+from .assembly import assemble, element_properties
+from .first_order import FirstOrderSystem, first_order
+from .matrices import AeroMatrices
+
+__all__ = ["AeroelasticModel", "NaturalModes"]
+
+
+@dataclass(frozen=True)
+class NaturalModes:
+    """Natural modes of the structure.
+
+    Attributes
+    ----------
+    frequencies : ndarray (n_modes,)
+        Natural frequencies [Hz].
+    shapes : ndarray (n_q, n_modes)
+        Mass-normalized mode shapes (structural unknowns, see ``dof_labels``).
+    labels : list of str
+        E.g. ``"1st bending"``, ``"1st torsion"``, ``"1st flap (aileron)"``.
+    """
+
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    labels: list[str]
+
+
+class AeroelasticModel:
+    """Aeroelastic beam finite-element model of a cantilever wing.
+
+    Parameters
+    ----------
+    wing : Wing
+        Geometry, structure and control surfaces (SI units).
+    n_elements : int
+        Number of beam elements along the span (default 10).
+    wagner : str, mapping or IndicialSet
+        Wagner approximation: ``"rt_jones"`` (default), ``"wp_jones"``, ``"one_term"``,
+        ``"fit2"``, ``"fit3"``, ``"fit4"``, or ``{"A": [...], "b": [...]}``.
+
+    Notes
+    -----
+    The structural and aerodynamic matrices do not depend on speed or density; they are
+    assembled here once. :meth:`system` scales them for a density (cached) and the state matrix
+    at speed V is ``A(V) = A0 + V A1 + V^2 A2``.
+    """
+
+    def __init__(self, wing: Wing, n_elements: int = 10, wagner: object = "rt_jones"):
+        if not isinstance(wing, Wing):
+            raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
+        self.wing = wing
+        self.n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
+        self.wagner: IndicialSet = wagner_set(wagner)
+        self.mesh: Mesh = build_mesh(wing, self.n_elements)
+        self.matrices: AeroMatrices = assemble(wing, self.mesh)
+        self.properties = element_properties(wing, self.mesh)
+        self._systems: dict[float, FirstOrderSystem] = {}
+
+    def __repr__(self) -> str:
+        return (
+            f"AeroelasticModel({self.wing.name!r}, n_elements={self.n_elements}, "
+            f"wagner={self.wagner.name!r}, n_states={self.n_states})"
+        )
+
+    @property
+    def n_dofs(self) -> int:
+        """Structural unknowns after the root clamp."""
+        return self.matrices.n_q
+
+    @property
+    def n_states(self) -> int:
+        """States of the first-order system: 2 x structural + lag terms x nodes."""
+        return 2 * self.n_dofs + self.wagner.n_terms * self.mesh.n_nodes
+
+    @property
+    def semichord(self) -> float:
+        """Span-averaged semichord [m]."""
+        return float(np.sum(self.properties["b"] * self.mesh.lengths) / self.wing.span)
+
+    def system(self, density: float) -> FirstOrderSystem:
+        """First-order system at air density ``density`` [kg/m^3] (cached)."""
+        rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+        if rho not in self._systems:
+            self._systems[rho] = first_order(self.matrices, self.wagner, rho, self.semichord)
+        return self._systems[rho]
+
+    def state_matrix(self, speed: float, density: float) -> np.ndarray:
+        """Dense state matrix A(V) [1/s] at ``speed`` [m/s] and ``density`` [kg/m^3]."""
+        v = check_number("speed", speed, unit="m/s", lo=0.0)
+        return self.system(density).state_matrix(v)
+
+    def natural_modes(self, n_modes: int = 6) -> NaturalModes:
+        """In-vacuo natural modes (structural mass and stiffness only).
+
+        Parameters
+        ----------
+        n_modes : int
+            Number of lowest modes.
+        """
+        n = check_int("n_modes", n_modes, lo=1, hi=self.n_dofs)
+        w2, phi = sla.eigh(
+            self.matrices.Ks.toarray(), self.matrices.Ms.toarray(), subset_by_index=[0, n - 1]
+        )
+        freqs = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
+        return NaturalModes(freqs, phi, self.label_modes(phi))
+
+    def label_modes(self, shapes: np.ndarray) -> list[str]:
+        """Name mode shapes by the dominant share of their strain energy.
+
+        Bending (EI w''^2), torsion (GJ phi'^2) or a flap (hinge springs, actuators, G_f J_f);
+        numbered in order of appearance, e.g. ``"2nd bending"``.
+
+        Parameters
+        ----------
+        shapes : ndarray (n_q, n_modes)
+        """
+        parts = self.matrices.stiffness_parts
+        counts: dict[str, int] = {}
+        labels = []
+        for j in range(shapes.shape[1]):
+            q = shapes[:, j]
+            energy = {name: float(np.real(np.vdot(q, k @ q))) for name, k in parts.items()}
+            kind = max(energy, key=energy.get)
+            counts[kind] = counts.get(kind, 0) + 1
+            labels.append(f"{_ordinal(counts[kind])} {kind}")
+        return labels
+
+    def nodal_fields(self, q: np.ndarray) -> dict[str, np.ndarray]:
+        """Split a structural vector into nodal fields (zeros where an unknown is absent).
+
+        Returns a dict with ``"x"`` (stations [m]), ``"w"`` [m], ``"theta"`` [rad], ``"phi"``
+        [rad] and ``"delta_<surface>"`` [rad] arrays over the nodes.
+        """
+        q = np.asarray(q)
+        m = self.mesh
+
+        def take(idx: np.ndarray) -> np.ndarray:
+            out = np.zeros(idx.shape, dtype=q.dtype)
+            out[idx >= 0] = q[idx[idx >= 0]]
+            return out
+
+        fields = {
+            "x": m.nodes.copy(),
+            "w": take(m.dof_w),
+            "theta": take(m.dof_theta),
+            "phi": take(m.dof_phi),
+        }
+        for k, cs in enumerate(self.wing.control_surfaces):
+            fields[f"delta_{cs.name}"] = take(m.dof_delta[k])
+        return fields
+
+
+def _ordinal(n: int) -> str:
+    suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"

@@ -1,0 +1,222 @@
+"""Assembly of the speed- and density-independent matrices of a wing stick model (seed eq. 6-7).
+
+Everything here runs once per (wing, mesh); speeds and densities only scale the results
+(:mod:`aeroservo.system`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..aero.theodorsen import section_aero
+from ..structure.beam_element import field_shapes, gauss_rule, integrate, lag_shapes, point_shapes
+from ..structure.mesh import Mesh
+from ..structure.wing import Wing
+from .matrices import AeroMatrices, StripGroup
+
+__all__ = ["assemble", "element_properties"]
+
+
+def element_properties(wing: Wing, mesh: Mesh) -> dict[str, np.ndarray]:
+    """Section properties per element (constant within an element by construction of the mesh).
+
+    Returns a dict of arrays of length n_elements: ``b, a, mass, s_alpha, inertia, EI, GJ`` of
+    the wing and ``c, s_beta, i_beta, GJ_f, k_delta`` of the flap (c = 1 and zeros where there
+    is no control surface: a zero-chord flap, whose aerodynamic terms all vanish).
+    """
+    segs = [wing.segments[i] for i in mesh.segment]
+    p = {
+        "b": np.array([s.semichord for s in segs]),
+        "a": np.array([s.a for s in segs]),
+        "mass": np.array([s.mass for s in segs]),
+        "s_alpha": np.array([s.static_moment for s in segs]),
+        "inertia": np.array([s.inertia for s in segs]),
+        "EI": np.array([s.EI for s in segs]),
+        "GJ": np.array([s.GJ for s in segs]),
+    }
+    n = mesh.n_elements
+    c = np.ones(n)
+    s_b, i_b, gj_f, k_d = (np.zeros(n) for _ in range(4))
+    for e, k in enumerate(mesh.surface):
+        if k >= 0:
+            cs = wing.control_surfaces[k]
+            c[e], s_b[e], i_b[e], gj_f[e], k_d[e] = (
+                cs.hinge,
+                cs.static_moment,
+                cs.inertia,
+                cs.GJ,
+                cs.hinge_stiffness,
+            )
+    p.update(c=c, s_beta=s_b, i_beta=i_b, GJ_f=gj_f, k_delta=k_d)
+    return p
+
+
+def _scatter(
+    blocks: np.ndarray, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]
+) -> sp.csr_matrix:
+    """Sum element blocks (n_el, p, q) into a sparse matrix, dropping removed unknowns (-1)."""
+    r = np.broadcast_to(rows[:, :, None], blocks.shape)
+    c = np.broadcast_to(cols[:, None, :], blocks.shape)
+    keep = (r >= 0) & (c >= 0) & (blocks != 0.0)
+    mat = sp.coo_matrix((blocks[keep], (r[keep], c[keep])), shape=shape)
+    return mat.tocsr()
+
+
+def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
+    """Build the structural and aerodynamic influence matrices of a wing.
+
+    Parameters
+    ----------
+    wing : Wing
+    mesh : Mesh
+        From :func:`aeroservo.structure.mesh.build_mesh`.
+
+    Returns
+    -------
+    AeroMatrices
+    """
+    p = element_properties(wing, mesh)
+    L = mesh.lengths
+    xi, wts = gauss_rule()
+    N, D, _ = field_shapes(L, xi)
+    n_el = mesh.n_elements
+    nz = lag_shapes(xi)[None, :, None, :].repeat(n_el, axis=0)  # (n_el, n_g, 1, 2)
+
+    # structural section matrices on [w, phi, delta]; flap terms vanish where there is no flap
+    y_h = p["b"] * (p["c"] - p["a"])
+    ms = np.zeros((n_el, 3, 3))
+    ms[:, 0, 0] = p["mass"]
+    ms[:, 0, 1] = ms[:, 1, 0] = -p["s_alpha"]
+    ms[:, 0, 2] = ms[:, 2, 0] = -p["s_beta"]
+    ms[:, 1, 1] = p["inertia"]
+    ms[:, 1, 2] = ms[:, 2, 1] = p["i_beta"] + y_h * p["s_beta"]
+    ms[:, 2, 2] = p["i_beta"]
+    kd = np.zeros((n_el, 3, 3))
+    kd[:, 0, 0], kd[:, 1, 1], kd[:, 2, 2] = p["EI"], p["GJ"], p["GJ_f"]
+    kn = np.zeros((n_el, 3, 3))
+    kn[:, 2, 2] = p["k_delta"]
+
+    aero = section_aero(p["b"], p["a"], p["c"])
+
+    def elem(left, coef, right):
+        return integrate(L, wts, left, coef[:, None], right)
+
+    # unknowns in an extended numbering: the clamped root (w, theta, phi) get the last 3 indices,
+    # so one scatter gives both the free matrices and the root-reaction rows
+    n_q = mesh.n_dofs
+    edofs = mesh.element_dofs.copy()
+    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
+    n_x = n_q + 3
+    n_n = mesh.n_nodes
+    lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
+
+    def split(blocks, rows, cols, shape):
+        """Scatter, then split extended structural rows/columns into free and root parts."""
+        full = _scatter(blocks, rows, cols, shape)
+        if cols is edofs:
+            full = full[:, :n_q]
+        if rows is edofs:
+            return full[:n_q], full[n_q:]
+        return full, None
+
+    def qq(coef, left=N, right=N):
+        return split(elem(left, coef, right), edofs, edofs, (n_x, n_x))
+
+    Ms, Ms_r = qq(ms)
+    parts, parts_r = {}, {}
+    for i, name in enumerate(("bending", "torsion")):
+        parts[name], parts_r[name] = qq(kd * _unit(i), D, D)
+    k_act = _actuator_stiffness(wing, mesh, n_q)
+    flap_all = qq(kd * _unit(2), D, D)[0] + qq(kn)[0] + k_act
+    for k, cs in enumerate(wing.control_surfaces):
+        mask = np.zeros(n_q)
+        d = mesh.dof_delta[k]
+        mask[d[d >= 0]] = 1.0
+        dm = sp.diags(mask)
+        parts[f"flap ({cs.name})"] = (dm @ flap_all @ dm).tocsr()
+    Ks = parts["bending"] + parts["torsion"] + flap_all
+    Ks_r = parts_r["bending"] + parts_r["torsion"]  # flap unknowns are never clamped
+
+    # circulatory matrices and load vectors grouped by semichord (exact C(k), gusts)
+    groups, groups_r = [], []
+    ones_z = np.ones((n_el, 1, 1))
+    for b in np.unique(p["b"]):
+        sel = (p["b"] == b).astype(float)[:, None, None]
+        pq, pq_r = qq(aero.Pq * sel)
+        pd, pd_r = qq(aero.Pd * sel)
+        gw = _scatter(elem(N, aero.w[:, :, None] * sel, nz), edofs, lag_dofs, (n_x, n_n))
+        gw = np.asarray(gw.sum(axis=1)).ravel()  # lag shape functions sum to one
+        groups.append(StripGroup(float(b), pq, pd, gw[:n_q]))
+        groups_r.append(StripGroup(float(b), pq_r, pd_r, gw[n_q:]))
+
+    # lag fields: term-independent base matrices on the nodes
+    Mz1 = _scatter(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
+    Lz1 = _scatter(elem(nz, (1.0 / p["b"])[:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n))
+    E1 = split(elem(nz, aero.r_q[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    F1 = split(elem(nz, aero.r_d[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    W1, W1_r = split(elem(N, aero.w[:, :, None], nz), edofs, lag_dofs, (n_x, n_n))
+    Mnc, Mnc_r = qq(aero.Mnc)
+    Cnc, Cnc_r = qq(aero.Cnc)
+    Knc, Knc_r = qq(aero.Knc)
+
+    labels = tuple(str(i) for i in range(n_n))
+    root = AeroMatrices(
+        Ms=Ms_r,
+        Ks=Ks_r,
+        Mnc=Mnc_r,
+        Cnc=Cnc_r,
+        Knc=Knc_r,
+        circ_groups=tuple(groups_r),
+        Mz1=Mz1,
+        Lz1=Lz1,
+        E1=E1,
+        F1=F1,
+        W1=W1_r,
+        dof_labels=mesh.dof_labels,
+        lag_labels=labels,
+    )
+    return AeroMatrices(
+        Ms=Ms,
+        Ks=Ks,
+        Mnc=Mnc,
+        Cnc=Cnc,
+        Knc=Knc,
+        circ_groups=tuple(groups),
+        Mz1=Mz1,
+        Lz1=Lz1,
+        E1=E1,
+        F1=F1,
+        W1=W1,
+        dof_labels=mesh.dof_labels,
+        lag_labels=labels,
+        stiffness_parts=parts,
+        root=root,
+    )
+
+
+def _unit(i: int) -> np.ndarray:
+    out = np.zeros((1, 3, 3))
+    out[0, i, i] = 1.0
+    return out
+
+
+def _actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
+    """Point springs k_act delta_D(x - x_a) acting on the flap rotation of their surface."""
+    rows, cols, vals = [], [], []
+    for k, cs in enumerate(wing.control_surfaces):
+        own = np.flatnonzero(mesh.surface == k)
+        for act in cs.actuators:
+            x = act.station
+            i = np.searchsorted(mesh.nodes[own + 1], x - 1e-12 * wing.span)
+            e = own[min(i, own.size - 1)]
+            xi = (x - mesh.nodes[e]) / (mesh.nodes[e + 1] - mesh.nodes[e])
+            n, _ = point_shapes(mesh.lengths[e], xi)
+            nd = n[2, 6:8]
+            dofs = mesh.element_dofs[e, 6:8]
+            for i in range(2):
+                for j in range(2):
+                    rows.append(dofs[i])
+                    cols.append(dofs[j])
+                    vals.append(act.stiffness * nd[i] * nd[j])
+    return sp.coo_matrix((vals, (rows, cols)), shape=(n_q, n_q)).tocsr()
