@@ -32,15 +32,15 @@ def test_limited_inside_restored_outside(monkeypatch):
 
 
 def test_flutter_boundary_runs_single_threaded(goland10, monkeypatch):
-    import aeroservo.stability.tracking as tr
+    import aeroservo.stability.boundary as bd
 
     seen = []
-    original = tr.EigenTracker.track
+    original = bd.sweep_branches
 
-    def spy(self, *a, **k):
+    def spy(*a, **k):
         seen.extend(blas_pools())
-        return original(self, *a, **k)
+        return original(*a, **k)
 
-    monkeypatch.setattr(tr.EigenTracker, "track", spy)
+    monkeypatch.setattr(bd, "sweep_branches", spy)
     aes.flutter_boundary(goland10, 1.225)
     assert seen and all(n == 1 for n in seen)

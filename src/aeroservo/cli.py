@@ -66,7 +66,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     f.add_argument("--wagner", help="Wagner set: rt_jones, wp_jones, one_term, fit2, fit3, fit4")
     f.add_argument("--v-max", type=_positive_float, help="upper end of the speed search [m/s]")
-    f.add_argument("--modes", type=_positive_int, help="number of tracked modes (default 8)")
+    f.add_argument(
+        "--modes",
+        type=_positive_int,
+        help="fewest modes in the modal model (default 6; the mode rule and the certificate "
+        "add what the wing needs, docs/stability.md)",
+    )
+
     f.add_argument(
         "--pk", action="store_true", help="also solve by p-k with the exact Theodorsen function"
     )
@@ -167,15 +173,17 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         )
         save_figure(fig, args.plot, dpi=150)
         out["plot"] = args.plot
+    for w in result.warnings:
+        print(f"aeroservo: warning: {w}", file=sys.stderr)
     if args.json:
         print(json.dumps(out, indent=2))
     else:
         print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
-        print(result.summary())
+        print(result.summary(warnings=False))
         if args.pk:
             pkr = out["pk_exact_theodorsen"]
             if pkr["flutter_speed"] is None:
-                print("p-k (exact Theodorsen): no flutter in the searched range")
+                print(f"p-k (exact Theodorsen): no flutter below {result.v_max:.4g} m/s")
             else:
                 print(
                     f"p-k (exact Theodorsen): flutter {pkr['flutter_speed']:.6g} m/s at "
@@ -272,10 +280,16 @@ def _readable(s: dict) -> str:
 
     lines = [f"{s.get('scenario', '')} [{s.get('kind')}]"]
     if s["kind"] == "flutter":
-        lines.append(
-            f"  flutter {f(s['flutter_speed'], ' m/s')} at {f(s['flutter_frequency'], ' Hz')}"
-            f" ({s.get('flutter_mode')}); divergence {f(s['divergence_speed'], ' m/s')}"
-        )
+        top = s.get("searched_range", [0.0, s.get("v_max")])[1]
+        if s["flutter_speed"] is None:
+            lines.append(f"  no flutter below {top:.5g} m/s")
+        else:
+            lines.append(
+                f"  flutter {f(s['flutter_speed'], ' m/s')} at {f(s['flutter_frequency'], ' Hz')}"
+                f" ({s.get('flutter_mode')})"
+            )
+        lines.append(f"  divergence {f(s['divergence_speed'], ' m/s')}")
+        lines += [f"  warning: {w}" for w in s.get("warnings", [])]
         if "pk_exact_theodorsen" in s:
             pk = s["pk_exact_theodorsen"]
             lines.append(f"  p-k, exact C(k): flutter {f(pk['flutter_speed'], ' m/s')}")

@@ -257,8 +257,10 @@ def field_row(model, field: int, x: float, surface: int | None = None) -> np.nda
 
 
 def surface_at(model, x: float) -> int | None:
-    for k, cs in enumerate(model.wing.control_surfaces):
-        if cs.start - 1e-12 <= x <= cs.end + 1e-12:
+    """Index of the control surface covering station x on the mesh, or None."""
+    tol = 1e-12 * model.wing.span
+    for k, (start, end) in enumerate(model.mesh.surface_extent):
+        if start - tol <= x <= end + tol:
             return k
     return None
 

@@ -1,10 +1,23 @@
 """The flutter and divergence boundary of a model at one air density.
 
-:func:`flutter_boundary` follows the lowest modes in speed (:mod:`aeroservo.stability.tracking`),
-finds every change of sign of the real part of each tracked branch by root finding (relative
-tolerance ``rtol``, not the grid spacing), locates hump modes whose peak lies between grid
-points (:func:`sign_changes`), and takes the divergence speed from the steady equations
-(:mod:`aeroservo.stability.divergence`).
+:func:`flutter_boundary` runs in four steps:
+
+1. **Divergence**: every static divergence speed, exactly, from the steady equations
+   (:mod:`aeroservo.stability.divergence`); it also sets the default speed range.
+2. **Sweep**: the eigenvalues of a modal model (:mod:`aeroservo.stability.modal`: every mode up
+   to a physical frequency cut-off) are computed with dense ``eig`` at every speed of an
+   adaptive grid and followed as branches (:mod:`aeroservo.stability.branches`); nothing has to
+   converge, so coalescences on the real axis, overdamped modes and flutter above divergence
+   pass without trouble.
+3. **Decisions on the full model**: wherever a branch is near the imaginary axis its eigenvalue
+   is recomputed on the full model, and every crossing and hump is found by root finding on the
+   full model's eigenvalue to a relative tolerance ``rtol`` (:mod:`aeroservo.stability.crossings`).
+4. **Certificate**: at checkpoints the full model's lightly damped and unstable eigenvalues are
+   computed independently and must all be in the modal model; if one is missing, the sweep is
+   redone with more modes (:mod:`aeroservo.stability.certificate`).
+
+If the sweep cannot go on (a non-finite eigenvalue, a branch the full model does not confirm),
+everything found below that speed is returned with ``searched_up_to`` and a warning.
 
 Damping convention: ``damping_ratio = -Re(lambda) / |lambda|`` (positive: stable);
 V-g plots show ``g = -2 zeta`` (positive: unstable).
@@ -13,26 +26,63 @@ V-g plots show ``g = -2 zeta`` (positive: unstable).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
+import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
 from ..system.first_order import FirstOrderSystem
-from .divergence import divergence_speed
+from .branches import Branches, is_complex, sweep_branches
+from .certificate import DENSE_LIMIT, Certificate, certify, truncated_modes
+from .crossings import VerificationError, Verifier, branch_crossings, sign_changes
+from .divergence import divergence_speeds
+from .modal import MIN_MODES, ModalBasis, ModalSystem, modal_basis, modal_system
 from .result import Crossing, FlutterResult
-from .tracking import EigenTracker, TrackedModes
+from .tracking import EigenTracker
 
-__all__ = ["flutter_boundary", "sign_changes"]
+__all__ = ["flutter_boundary", "sign_changes", "default_v_max"]
+
+CHECKPOINTS = (0.25, 0.5, 0.75, 1.0)
+"""Fractions of the speed range at which the certificate checks the modal model."""
+
+MAX_ENLARGE = 3
+"""Times the certificate may enlarge the modal model before the full model is used."""
 
 
-def _as_system(model: object, density: float | None) -> tuple[FirstOrderSystem, Callable | None]:
+def _as_system(model: object, density: float | None) -> tuple[FirstOrderSystem, object]:
+    """The full first-order system, and the model it comes from (None for a bare system)."""
     if isinstance(model, FirstOrderSystem):
         return model, None
+    if not hasattr(model, "system") or not hasattr(model, "matrices"):
+        raise InputError(
+            f"model = {model!r}: expected an AeroelasticModel, a TypicalSection or a "
+            "FirstOrderSystem"
+        )
     if density is None:
         raise InputError("density = None: give the air density [kg/m^3]")
     rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-    return model.system(rho), getattr(model, "label_modes", None)
+    return model.system(rho), model
+
+
+def default_v_max(semichord: float, omega_2: float, v_div: np.ndarray) -> float:
+    """Default upper speed [m/s]: 1.2 x the first divergence speed, at most 8 b omega_2, or
+    4 b omega_2 without divergence.
+
+    Parameters
+    ----------
+    semichord : float
+        Mean semichord b [m].
+    omega_2 : float
+        Second frequency at rest [rad/s].
+    v_div : ndarray
+        Static divergence speeds [m/s], increasing.
+    """
+    ref = semichord * omega_2
+    if v_div.size:
+        return float(min(1.2 * v_div[0], 8.0 * ref))
+    return float(4.0 * ref)
 
 
 @blas_limited
@@ -44,165 +94,283 @@ def flutter_boundary(
     n_modes: int | None = None,
     rtol: float = 1e-7,
     progress: Callable[[float], None] | None = None,
+    exact_branches: bool = False,
 ) -> FlutterResult:
     """Flutter and divergence boundaries of a model at one air density.
 
     Parameters
     ----------
     model : AeroelasticModel, TypicalSection or FirstOrderSystem
-        Anything with ``system(density)``; a :class:`FirstOrderSystem` is used as is.
+        A model (its modal model is swept) or a first-order system (swept as it is, every
+        mode followed).
     density : float
-        Air density [kg/m^3].
+        Air density [kg/m^3] (not needed for a FirstOrderSystem).
     v_max : float, optional
-        Upper end of the speed range [m/s]. Default: 1.2 x the divergence speed, or
-        4 b omega_2 (semichord times second in-air frequency) when there is no divergence.
+        Upper end of the speed range [m/s]. Default (:func:`default_v_max`): 1.2 x the first
+        divergence speed (at most 8 b omega_2), or 4 b omega_2 without divergence, with b the
+        mean semichord and omega_2 the second frequency at rest.
     n_modes : int, optional
-        Number of lowest modes tracked (default: 8, or all if the model has fewer).
+        Fewest modes in the modal model (default 6). The modes kept follow a physical rule
+        (:func:`aeroservo.stability.modal.mode_rule`) and the certificate adds any it finds
+        missing, so the answer does not depend on this number.
     rtol : float
-        Relative tolerance on crossing speeds (the issue asks 1e-5; default 1e-7).
+        Relative tolerance on crossing speeds (default 1e-7).
     progress : callable, optional
         Called with each accepted speed [m/s].
+    exact_branches : bool
+        Recompute every branch value on the full model (by default only those near the
+        imaginary axis are; the others are the modal model's, to about 1e-3).
 
     Returns
     -------
     FlutterResult
     """
-    system, labeller = _as_system(model, density)
-    n_modes = min(8, system.n_q) if n_modes is None else n_modes
-    n_modes = check_int("n_modes", n_modes, lo=1, hi=system.n_q)
-    lam0, X0 = system.modes_at_rest(n_modes)
-    v_div = divergence_speed(system)
-    if v_max is None:
-        if v_div is not None:
-            v_max = 1.2 * v_div
-        else:
-            v_max = 4.0 * system.semichord * float(np.abs(lam0[min(1, lam0.size - 1)]))
-    v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
-
-    tracker = EigenTracker(system)
-    tracked = tracker.track(v_max, lam0, X0, progress=progress)
-    crossings = _find_crossings(tracker, tracked, rtol)
-    if labeller is not None:
-        labels = labeller(X0[: system.n_q].real)
+    system, src = _as_system(model, density)
+    n_min = MIN_MODES if n_modes is None else check_int("n_modes", n_modes, lo=1, hi=system.n_q)
+    rtol = check_number("rtol", rtol, lo=1e-14, hi=1e-2)
+    warnings = list(getattr(getattr(src, "mesh", None), "warnings", ()))
+    v_div = divergence_speeds(system)
+    if src is None:
+        lam_full0, _ = system.modes_at_rest(system.n_q if n_modes is None else n_min)
     else:
-        labels = [f"mode {j + 1}" for j in range(n_modes)]
+        lam_full0, _ = system.modes_at_rest(min(max(n_min, 2), system.n_q))
+    omega_2 = float(np.abs(lam_full0[min(1, lam_full0.size - 1)]))
+    if v_max is None:
+        v_max = default_v_max(system.semichord, omega_2, v_div)
+    v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
+    tracker = EigenTracker(system)
+    basis = _checked_basis(src, n_min, system.density, v_max) if src is not None else None
+    crossings: list[Crossing] | None = None
+    for attempt in range(MAX_ENLARGE + 1):
+        modal = _modal(src, system, basis, n_modes)
+        br, ver, cert = _sweep(tracker, src, modal, v_max, progress)
+        top = float(br.speeds[-1])
+        errors = _branch_errors(cert, br.eigenvalues.shape[1])
+        band_top = 2 * np.pi * 1.1 * basis.cutoff if modal.basis is not None else np.inf
+        missing = list(cert.missing)
+        if cert.ok:
+            try:
+                crossings = _crossings(ver, rtol, errors, band_top)
+            except VerificationError as exc:
+                missing = [(exc.speed, exc.eigenvalue)]
+            except (RuntimeError, ValueError):
+                break  # not a missing mode: decided as far as possible below
+        if crossings is not None or modal.basis is None or attempt == MAX_ENLARGE:
+            break
+        lost = max(abs(lam.imag) for _v, lam in missing) / (2 * np.pi)
+        cutoff = max(1.5 * basis.cutoff, 1.3 * lost)
+        why = "certificate" if not cert.ok else "full model"
+        warnings.append(
+            f"the {why} found a lightly damped mode near {lost:.4g} Hz that the modal model "
+            f"({basis.n_modes} modes, band up to {basis.cutoff:.4g} Hz) lacked or misplaced; "
+            f"swept again with the band up to {cutoff:.4g} Hz"
+        )
+        basis = _checked_basis(src, n_min, system.density, v_max, cutoff)
+    if not cert.ok:
+        warnings.append(
+            "the certificate still finds full-model eigenvalues the modal model lacks: "
+            + ", ".join(
+                f"{abs(lam.imag) / (2 * np.pi):.4g} Hz at {v:.4g} m/s"
+                for v, lam in cert.missing[:3]
+            )
+        )
+    if br.stopped:
+        warnings.append(f"search stopped at {top:.6g} m/s: {br.stopped}; results below it stand")
+    if crossings is None:
+        crossings, top = _crossings_as_far_as_possible(ver, rtol, errors, band_top, top, warnings)
+    crossings = [c for c in crossings if c.speed <= top]
+    if exact_branches:
+        _verify_all(ver)
+    crossings += _divergence(br, v_div, top)
+    crossings.sort(key=lambda c: c.speed)
+    lam = np.column_stack([ver.best(j) for j in range(br.eigenvalues.shape[1])])
+    exact = ver.exact.copy()
+    if modal.basis is None:
+        exact[:] = True  # the modal model is the full model
+    if modal.basis is not None:  # at rest: the full model's modes (apparent mass included)
+        lam[0] = system.modes_at_rest(lam.shape[1])[0]
+        exact[0] = True
+    labels = _labels(src, modal, br)
+    info = {
+        "method": "modal sweep, decisions and crossings on the full model",
+        "n_factorizations": tracker.n_factorizations,
+        "n_speeds": int(br.n_speeds),
+        "ambiguous_steps": int(br.n_ambiguous),
+        "divergence_speeds": [float(v) for v in v_div if v <= top],
+        "modal_model": _modal_info(modal),
+        "certificate": cert.to_dict(),
+    }
     return FlutterResult(
-        speeds=tracked.speeds,
-        eigenvalues=tracked.eigenvalues,
-        mode_labels=list(labels),
+        speeds=br.speeds,
+        eigenvalues=lam,
+        mode_labels=labels,
         crossings=crossings,
-        divergence_speed=v_div,
+        divergence_speed=float(v_div[0]) if v_div.size else None,
         density=system.density,
         v_max=v_max,
         n_states=system.n_states,
-        info={"n_factorizations": tracker.n_factorizations},
+        info=info,
+        searched_up_to=top,
+        warnings=warnings,
+        exact=exact,
     )
 
 
-class _Branch:
-    """One tracked branch: its eigenvalue anywhere in the grid's range, by continuation."""
-
-    def __init__(self, tracker: EigenTracker, tr: TrackedModes, j: int):
-        self.tracker = tracker
-        self.V = tr.speeds
-        self.lam = tr.eigenvalues[:, j]
-        self.vec = tr.vectors[:, :, j]
-        self.j = j
-
-    def eig(self, v: float, k: int) -> complex:
-        """Eigenvalue at speed v, continued from grid point k (the inboard end of a bracket)."""
-        V, lam = self.V, self.lam
-        t = (v - V[k]) / (V[k + 1] - V[k])
-        guess = lam[k] + t * (lam[k + 1] - lam[k])
-        return self.tracker.follow(v, guess, self.vec[k], V[k])[0]
-
-    def re(self, v: float, k: int) -> float:
-        return float(self.eig(v, k).real)
-
-    def crossing(self, v: float, k: int, rising: bool) -> Crossing:
-        """The crossing at speed v (a root of Re(lambda) inside grid interval k)."""
-        lam_c = self.eig(v, k)
-        osc = abs(lam_c.imag) > 1e-6 * max(abs(lam_c.real), 1.0)
-        kind = ("onset" if rising else "recovery") if osc else "divergence"
-        return Crossing(float(v), abs(lam_c.imag) / (2 * np.pi) if osc else 0.0, self.j, kind)
+def _checked_basis(src, n_min: int, rho: float, v_max: float, cutoff=None) -> ModalBasis:
+    """The rule's modes, plus every mode the truncation check cannot leave out."""
+    basis = modal_basis(src, n_min, cutoff)
+    notes = []
+    for _ in range(8):
+        n_band = int(np.sum(basis.frequencies <= basis.cutoff * (1 + 1e-9)))
+        bad = truncated_modes(src, n_band, rho, v_max)
+        if not bad:
+            break
+        f_bad, why = max(bad)
+        notes.append(f"{f_bad:.4g} Hz ({why})")
+        basis = modal_basis(src, n_min, max(basis.cutoff, 1.01 * f_bad))
+    if notes:
+        basis = replace(basis, rule=basis.rule + "; kept as well: " + ", ".join(notes))
+    return basis
 
 
-HUMP_ZETA = 0.05
-"""Interior extrema of Re(lambda) with |damping ratio| below this are refined between grid
-points (the step control keeps eigenvalue changes per step below 10 %, so a hump that crosses
-zero cannot hide behind grid values further from zero than this)."""
+def _modal(src, system: FirstOrderSystem, basis: ModalBasis | None, n_modes) -> ModalSystem:
+    if src is None:
+        return ModalSystem(system, None, None, 0)
+    return modal_system(src, system.density, basis)
 
 
-def sign_changes(
-    fun: Callable[[float, int], float],
-    V: np.ndarray,
-    g: np.ndarray,
-    zeta: np.ndarray,
-    rtol: float,
-    first: int = 1,
-) -> list[tuple[float, bool, int]]:
-    """Roots in speed of a continuous stability measure known on a grid, humps included.
+def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progress):
+    """Sweep the modal model, verify it near the axis and certify it at the checkpoints."""
+    sys_m = modal.system
+    m = modal.basis.n_modes if modal.basis is not None else sys_m.n_q
+    lam0, X0 = sys_m.modes_at_rest(m)
+    checkpoints = [f * v_max for f in CHECKPOINTS]
+    br = sweep_branches(sys_m, lam0, X0, v_max, forced=checkpoints, progress=progress)
+    ver = Verifier(tracker, modal, br)
+    if modal.basis is None:
+        ver.values[:] = br.eigenvalues  # the modal model is the full model
+        return br, ver, Certificate(method="modal model is the full model")
+    idx = sorted({int(np.argmin(np.abs(br.speeds - v))) for v in checkpoints if v <= br.speeds[-1]})
+    band_top = 1.1 * 2 * np.pi * modal.basis.cutoff
 
-    Parameters
-    ----------
-    fun : callable
-        ``fun(v, k)``: the measure (e.g. Re(lambda) [1/s]) at speed v inside grid interval k.
-    V : ndarray
-        Increasing grid speeds [m/s].
-    g : ndarray
-        The measure on the grid (negative: stable).
-    zeta : ndarray
-        Damping ratio on the grid; interior extrema with ``|zeta| < HUMP_ZETA`` that do not
-        change sign on the grid are refined (a hump that crosses zero between grid points).
-    rtol : float
-        Relative tolerance on the roots.
-    first : int
-        Index of the first grid point used in the sign test (1 skips V = 0, where an undamped
-        structure has Re = 0 exactly).
+    full = tracker.system
+    if full.n_states <= DENSE_LIMIT:
+        method = "dense eig of the full model"
 
-    Returns
-    -------
-    list of (speed, rising, k)
-        Root [m/s], whether the measure goes from negative to positive, grid interval.
-    """
-    from scipy.optimize import brentq, minimize_scalar
+        def reference(v: float) -> np.ndarray:
+            return sla.eigvals(full.state_matrix(v))
 
-    def root(k: int, a: float, b: float) -> float:
-        return float(brentq(fun, a, b, args=(k,), xtol=rtol * b, rtol=1e-15))
+    else:
+        n_big = min(2 * m, full.n_q)
+        big = modal_system(src, full.density, modal_basis(src, n_big)).system
+        method = f"modal model of {n_big} modes; branches in the band verified on the full model"
 
-    out = []
-    for k in range(first, V.size - 1):
-        if (g[k] < 0) != (g[k + 1] < 0):
-            out.append((root(k, V[k], V[k + 1]), bool(g[k] < 0), k))
-    for k in range(first + 1, V.size - 1):
-        for sgn in (1.0, -1.0):
-            gk = sgn * g
-            if not (gk[k] >= gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
-                continue
-            if abs(zeta[k]) >= HUMP_ZETA:
-                continue
-            # search both grid intervals around the extreme, continuing from the left one
-            sol = minimize_scalar(
-                lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
-                bounds=(V[k - 1], V[k + 1]),
-                method="bounded",
-                options={"xatol": rtol * V[k + 1]},
-            )
-            if -sol.fun > 0:
-                vpk = float(sol.x)
-                kk = k - 1 if vpk < V[k] else k
-                out.append((root(kk, V[kk], vpk), sgn > 0, kk))
-                out.append((root(kk, vpk, V[kk + 1]), sgn < 0, kk))
-    return sorted(out)
+        def reference(v: float) -> np.ndarray:
+            return sla.eigvals(big.state_matrix(v))
+
+        for k in idx:
+            for j in np.flatnonzero(
+                is_complex(br.eigenvalues[k]) & (np.abs(br.eigenvalues[k]) <= band_top)
+            ):
+                ver.at(k, int(j))
+    cert = certify(reference, br, ver.exact, ver.values, idx, band_top, method)
+    return br, ver, cert
 
 
-def _find_crossings(tracker: EigenTracker, tr: TrackedModes, rtol: float) -> list[Crossing]:
-    V = tr.speeds
+def _branch_errors(cert: Certificate, m: int) -> np.ndarray:
+    """Measured modal error per branch; the largest one where a branch was never checked."""
+    err = cert.branch_error if cert.branch_error is not None else np.full(m, np.nan)
+    worst = float(np.nanmax(err)) if np.isfinite(err).any() else cert.max_mismatch
+    return np.where(np.isfinite(err), err, max(worst, cert.max_mismatch))
+
+
+def _crossings(ver: Verifier, rtol: float, errors: np.ndarray, band_top: float) -> list:
+    """Onsets and recoveries of every branch (raises VerificationError if the full model does
+    not confirm a branch in the band)."""
     out: list[Crossing] = []
-    for j in range(tr.eigenvalues.shape[1]):
-        br = _Branch(tracker, tr, j)
-        zeta = -br.lam.real / np.maximum(np.abs(br.lam), 1e-300)
-        for v, rising, k in sign_changes(br.re, V, br.lam.real, zeta, rtol):
-            out.append(br.crossing(v, k, rising))
-    out.sort(key=lambda c: c.speed)
+    for j in range(ver.br.eigenvalues.shape[1]):
+        out += branch_crossings(ver, j, rtol, float(errors[j]), band_top)
+    return _dedupe(out)
+
+
+def _crossings_as_far_as_possible(
+    ver: Verifier, rtol: float, errors: np.ndarray, band_top: float, top: float, warnings: list
+) -> tuple[list, float]:
+    """As :func:`_crossings`, but a branch the full model cannot confirm ends the complete part
+    of the search at the speed where that happened."""
+    out: list[Crossing] = []
+    for j in range(ver.br.eigenvalues.shape[1]):
+        try:
+            out += branch_crossings(ver, j, rtol, float(errors[j]), band_top)
+        except (VerificationError, RuntimeError, ValueError) as exc:
+            bad = getattr(exc, "speed", float(ver.br.speeds[0]))
+            top = min(top, bad)
+            warnings.append(
+                f"search complete only up to {top:.6g} m/s: {exc}; try more modes (n_modes, "
+                "--modes) or a finer mesh, and report the wing if it persists"
+            )
+    return _dedupe([c for c in out if c.speed <= top]), top
+
+
+def _dedupe(crossings: list[Crossing]) -> list[Crossing]:
+    out: list[Crossing] = []
+    for c in sorted(crossings, key=lambda c: c.speed):
+        if any(
+            d.kind == c.kind
+            and abs(d.speed - c.speed) <= 1e-6 * c.speed
+            and abs(d.frequency - c.frequency) <= 1e-6 * max(c.frequency, 1e-12)
+            for d in out
+        ):
+            continue
+        out.append(c)
     return out
+
+
+def _divergence(br: Branches, v_div: np.ndarray, top: float) -> list[Crossing]:
+    """A crossing at each static divergence speed in range, on the branch nearest zero."""
+    out = []
+    for v in v_div[v_div <= top]:
+        k = int(np.argmin(np.abs(br.speeds - v)))
+        j = int(np.argmin(np.abs(br.eigenvalues[k])))
+        out.append(Crossing(float(v), 0.0, j, "divergence"))
+    return out
+
+
+def _verify_all(ver: Verifier) -> None:
+    n, m = ver.br.eigenvalues.shape
+    for k in range(1, n):
+        for j in range(m):
+            try:
+                ver.at(k, j)
+            except (VerificationError, RuntimeError):
+                pass
+
+
+def _labels(src, modal: ModalSystem, br: Branches) -> list[str]:
+    m = br.eigenvalues.shape[1]
+    labeller = getattr(src, "label_modes", None)
+    if labeller is None:
+        return [f"mode {j + 1}" for j in range(m)]
+    x = modal.lift(br.vectors[0])
+    return list(labeller(np.real(x[: modal_n_q(src)])))
+
+
+def modal_n_q(src) -> int:
+    return src.matrices.n_q
+
+
+def _modal_info(modal: ModalSystem) -> dict:
+    b = modal.basis
+    if b is None:
+        return {
+            "n_modes": modal.system.n_q,
+            "rule": "full model",
+            "n_states": modal.system.n_states,
+        }
+    return {
+        "n_modes": b.n_modes,
+        "cutoff_hz": b.cutoff,
+        "rule": b.rule,
+        "n_states": modal.system.n_states,
+        "lag_states": "projected" if modal.lag_basis is not None else "complete",
+    }

@@ -1,4 +1,14 @@
-"""Static divergence: the speeds at which the steady aeroelastic stiffness becomes singular."""
+"""Static divergence: the speeds at which the steady aeroelastic stiffness becomes singular.
+
+``(Ks + rho V^2 K_static) q = 0`` has a non-trivial solution where ``V^2 = 1 / (rho mu)`` for a
+real positive eigenvalue ``mu`` of ``-Ks^-1 K_static``. Exactly there ``det A(V) = 0``: a real
+eigenvalue of the first-order system passes through zero. The eigenvalues are computed in the
+basis of in-vacuo modes scaled to unit stiffness (``Ks -> I``), so that round-off is relative to
+each mode's own scale, and an eigenvalue counts as a divergence only if it is real and positive
+well above round-off (:data:`ROUND_OFF`): a wing whose elastic axis lies ahead of the quarter
+chord has no divergence, and round-off eigenvalues (1e-13 of the largest) must not report one at
+1e9 m/s.
+"""
 
 from __future__ import annotations
 
@@ -7,19 +17,48 @@ import scipy.linalg as sla
 
 from ..system.first_order import FirstOrderSystem
 
-__all__ = ["divergence_speed"]
+__all__ = ["divergence_speed", "divergence_speeds", "static_speeds"]
+
+ROUND_OFF = 1e-9
+"""Eigenvalues ``mu`` below this fraction of the largest ``|mu|`` are round-off, not divergence."""
+
+
+def static_speeds(Ks: np.ndarray, K_static: np.ndarray, density: float) -> np.ndarray:
+    """Every static divergence speed [m/s], increasing.
+
+    Parameters
+    ----------
+    Ks : ndarray (n, n)
+        Structural stiffness (symmetric positive definite).
+    K_static : ndarray (n, n)
+        Steady aerodynamic stiffness per unit ``rho V^2`` (lag states eliminated).
+    density : float
+        Air density [kg/m^3].
+    """
+    Ks = np.asarray(Ks, dtype=float)
+    K_static = np.asarray(K_static, dtype=float)
+    w2, phi = sla.eigh(Ks)  # Ks = phi diag(w2) phi^T, w2 > 0
+    scale = phi / np.sqrt(np.clip(w2, np.finfo(float).tiny, None))
+    S = -(scale.T @ K_static @ scale)
+    mu = sla.eigvals(S)
+    mu = mu[np.isfinite(mu)]
+    if mu.size == 0:
+        return np.empty(0)
+    big = float(np.max(np.abs(mu)))
+    keep = (mu.real > ROUND_OFF * big) & (np.abs(mu.imag) <= 1e-8 * np.abs(mu))
+    return np.sort(1.0 / np.sqrt(density * mu.real[keep]))
+
+
+def divergence_speeds(system: FirstOrderSystem) -> np.ndarray:
+    """Every static divergence speed [m/s] of a first-order system, increasing."""
+    return static_speeds(system.Ks.toarray(), system.K_static, system.density)
 
 
 def divergence_speed(system: FirstOrderSystem) -> float | None:
-    """Static divergence speed [m/s] of a first-order system, or None.
+    """The lowest static divergence speed [m/s] of a first-order system, or None.
 
-    Solves ``Ks q = -rho V^2 K_static q`` for the smallest positive ``V^2``.
+    Solves ``Ks q = -rho V^2 K_static q`` for the smallest positive ``V^2``
+    (:func:`static_speeds`).
     """
-    ks = system.Ks.toarray()
-    mu = sla.eigvals(-system.K_static, ks)
-    mu = mu[np.isfinite(mu)]
-    real = np.abs(mu.imag) <= 1e-8 * np.abs(mu)
-    mu = mu[real & (mu.real > 0)].real
-    if mu.size == 0:
-        return None
-    return float(1.0 / np.sqrt(system.density * mu.max()))
+    v = divergence_speeds(system)
+    return float(v[0]) if v.size else None

@@ -25,6 +25,9 @@ from .._threads import blas_limited
 from ..aero.theodorsen import theodorsen_function
 from ..errors import check_int, check_number
 from ..system.matrices import AeroMatrices
+from .boundary import default_v_max
+from .divergence import static_speeds
+from .modal import modal_basis
 from .result import Crossing, FlutterResult
 from .tracking import mac
 
@@ -140,12 +143,10 @@ def _setup(am: AeroMatrices, rho: float) -> tuple[_PK, np.ndarray]:
 
 
 def static_divergence_speed(am: AeroMatrices, density: float) -> float | None:
-    """Divergence speed [m/s] with the exact steady strip aerodynamics (C = 1), or None."""
-    k_static = am.Knc.toarray() - am.Pq.toarray()
-    mu = sla.eigvals(-k_static, am.Ks.toarray())
-    mu = mu[np.isfinite(mu)]
-    mu = mu[(np.abs(mu.imag) <= 1e-8 * np.abs(mu)) & (mu.real > 0)].real
-    return None if mu.size == 0 else float(1.0 / np.sqrt(density * mu.max()))
+    """Lowest divergence speed [m/s] with the exact steady strip aerodynamics (C = 1), or None
+    (robust to round-off: :func:`aeroservo.stability.divergence.static_speeds`)."""
+    v = static_speeds(am.Ks.toarray(), am.Knc.toarray() - am.Pq.toarray(), density)
+    return float(v[0]) if v.size else None
 
 
 @blas_limited
@@ -167,9 +168,11 @@ def pk_flutter(
     density : float
         Air density [kg/m^3].
     v_max : float, optional
-        Upper speed [m/s]; default 1.2 x the exact static divergence speed, else 4 b omega_2.
+        Upper speed [m/s]; default as :func:`aeroservo.stability.boundary.default_v_max`
+        (1.2 x the exact static divergence speed, at most 8 b omega_2, else 4 b omega_2).
     n_modes : int, optional
-        Lowest modes followed (default: 6, or all if the model has fewer).
+        Lowest modes followed (default: the modes of the same physical rule as the time-domain
+        search, :func:`aeroservo.stability.modal.mode_rule`).
     n_speeds : int
         Uniform grid points from 0 to ``v_max`` (crossings are then found by root finding).
     rtol : float
@@ -182,16 +185,18 @@ def pk_flutter(
     """
     rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
     am: AeroMatrices = model.matrices
-    n_modes = min(6, am.n_q) if n_modes is None else n_modes
+    if n_modes is None:
+        n_modes = modal_basis(model).n_modes
     n_modes = check_int("n_modes", n_modes, lo=1, hi=am.n_q)
     n_speeds = check_int("n_speeds", n_speeds, lo=3)
     pk, basis = _setup(am, rho)
     w2, phi = sla.eigh(pk.Ks, pk.M, subset_by_index=[0, n_modes - 1])
     p0 = 1j * np.sqrt(w2)
-    v_div = static_divergence_speed(am, rho)
+    v_divs = static_speeds(am.Ks.toarray(), am.Knc.toarray() - am.Pq.toarray(), rho)
+    v_div = float(v_divs[0]) if v_divs.size else None
     if v_max is None:
-        b_ref = float(np.mean([g.b for g in am.circ_groups]))
-        v_max = 1.2 * v_div if v_div else 4.0 * b_ref * abs(p0[min(1, n_modes - 1)])
+        b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
+        v_max = default_v_max(b_ref, float(abs(p0[min(1, n_modes - 1)])), v_divs)
     v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
     speeds = np.linspace(0.0, v_max, n_speeds)
     P = np.empty((n_speeds, n_modes), dtype=complex)

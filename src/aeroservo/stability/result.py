@@ -54,6 +54,17 @@ class FlutterResult:
         Upper end of the speed range searched [m/s].
     n_states : int
         Size of the first-order system.
+    searched_up_to : float or None
+        Speed up to which the search is complete [m/s]: ``v_max``, or less when it stopped
+        early (see ``warnings``); everything found below it stands.
+    warnings : list of str
+        What the user should know (a search cut short, mesh edges merged, modes added by the
+        certificate), one sentence each.
+    exact : ndarray (n_speeds, n_modes) of bool or None
+        Which branch values are eigenvalues of the full model (the others come from the modal
+        model, accurate to about 1e-3 of their modulus); None: all are.
+    info : dict
+        Method details (modal model, certificate, counts), JSON-ready.
     """
 
     speeds: np.ndarray
@@ -65,6 +76,18 @@ class FlutterResult:
     v_max: float
     n_states: int
     info: dict = field(default_factory=dict)
+    searched_up_to: float | None = None
+    warnings: list = field(default_factory=list)
+    exact: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.searched_up_to is None:
+            self.searched_up_to = self.v_max
+
+    @property
+    def complete(self) -> bool:
+        """Whether the whole range 0 .. ``v_max`` was searched."""
+        return self.searched_up_to >= self.v_max * (1 - 1e-12)
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -112,6 +135,8 @@ class FlutterResult:
             "density": self.density,
             "n_states": self.n_states,
             "v_max": self.v_max,
+            "searched_range": [0.0, self.searched_up_to],
+            "warnings": list(self.warnings),
             "crossings": [
                 {
                     "speed": c.speed,
@@ -128,11 +153,14 @@ class FlutterResult:
             **self.info,
         }
 
-    def summary(self) -> str:
-        """Readable multi-line summary."""
-        lines = [f"density {self.density:g} kg/m^3, speeds searched 0 .. {self.v_max:.4g} m/s"]
+    def summary(self, warnings: bool = True) -> str:
+        """Readable multi-line summary (with the warnings, unless ``warnings=False``)."""
+        top = self.searched_up_to
+        lines = [f"density {self.density:g} kg/m^3, speeds searched 0 .. {top:.4g} m/s"]
+        if not self.complete:
+            lines[0] += f" (of {self.v_max:.4g} m/s asked: the search stopped early)"
         if self.flutter is None:
-            lines.append("flutter: none found in the searched range")
+            lines.append(f"flutter: no flutter below {top:.4g} m/s")
         else:
             lines.append(
                 f"flutter: {self.flutter_speed:.6g} m/s at {self.flutter_frequency:.5g} Hz "
@@ -153,4 +181,6 @@ class FlutterResult:
                 f"{lab} ({self.frequencies[0, j]:.4g} Hz)" for j, lab in enumerate(self.mode_labels)
             )
         )
+        if warnings:
+            lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)

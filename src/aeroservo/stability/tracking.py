@@ -1,25 +1,22 @@
-"""Continuation of selected eigenpairs of ``(A0 + V A1 + V^2 A2) x = lambda E x`` in speed.
+"""Eigenpair correction on the full model: ``(A0 + V A1 + V^2 A2) x = lambda E x`` at one speed.
 
-Each tracked eigenpair is corrected at a new speed by shifted inverse iteration started from
-an extrapolated prediction (one LU of ``A(V) - sigma E`` per mode and step, LAPACK for small
-systems and SuperLU for large ones, re-shifted when convergence is slow). A step is accepted
-only when every mode converged, its eigenvector correlates with the previous one (MAC above a
-threshold) and no two modes landed on the same eigenvalue; otherwise the step is halved.
-Branches therefore never swap where frequencies cross, and the cost grows with the number of
-tracked modes, not with the size of the model.
+The stability sweep runs on a modal model (:mod:`aeroservo.stability.branches`); every decision
+that depends on the sign of a real part near the imaginary axis is made on the full model, by
+shifted inverse iteration started from the modal model's eigenpair (one LU of
+``A(V) - sigma E`` per correction, LAPACK for small systems and SuperLU for large ones,
+re-shifted when convergence is slow).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg.lapack import zgetrf, zgetrs
 
 from ..system.first_order import FirstOrderSystem
 
-__all__ = ["EigenTracker", "TrackedModes", "mac"]
+__all__ = ["EigenTracker", "mac"]
 
 DENSE_LIMIT = 200
 """Systems up to this many states use dense LU; larger ones use sparse LU (SuperLU)."""
@@ -32,27 +29,8 @@ def mac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return num / den
 
 
-@dataclass
-class TrackedModes:
-    """Eigenvalues of tracked modes on a speed grid.
-
-    Attributes
-    ----------
-    speeds : ndarray (n_speeds,)
-        Airspeeds [m/s], increasing.
-    eigenvalues : ndarray (n_speeds, n_modes) complex
-        Eigenvalues [1/s]; Im >= 0 for the tracked member of each complex pair.
-    vectors : ndarray (n_speeds, n_states, n_modes) complex
-        Unit state eigenvectors.
-    """
-
-    speeds: np.ndarray
-    eigenvalues: np.ndarray
-    vectors: np.ndarray
-
-
 class EigenTracker:
-    """Eigenpair correction and continuation for one :class:`FirstOrderSystem`.
+    """Eigenpair correction of one :class:`FirstOrderSystem` (the full model).
 
     Parameters
     ----------
@@ -168,75 +146,6 @@ class EigenTracker:
                 prev_dl = dl
             sigma = lam
         return lam, x, False
-
-    # -- continuation ---------------------------------------------------------------------
-    def track(
-        self,
-        v_max: float,
-        lam0: np.ndarray,
-        X0: np.ndarray,
-        *,
-        h_init: float | None = None,
-        h_max: float | None = None,
-        max_rel_change: float = 0.1,
-        pred_tol: float = 1e-2,
-        progress: Callable[[float], None] | None = None,
-    ) -> TrackedModes:
-        """Follow eigenpairs ``(lam0, X0)`` given at V = 0 up to ``v_max`` [m/s].
-
-        The step adapts so that no eigenvalue moves by more than ``max_rel_change`` of its
-        modulus between consecutive speeds (this bounds how far a hump can hide between grid
-        points), so that the linear predictor misses by at most about ``pred_tol`` of the
-        modulus (fine steps where a branch bends), and never exceeds ``h_max`` (default
-        ``v_max / 15``).
-        """
-        h_max = h_max or v_max / 15.0
-        h = h_init or v_max / 30.0
-        h_min = v_max * 1e-7
-        speeds = [0.0]
-        lams = [np.asarray(lam0, dtype=complex)]
-        vecs = [np.asarray(X0, dtype=complex)]
-        V = 0.0
-        while V < v_max * (1 - 1e-12):
-            h = min(h, v_max - V)
-            V1 = V + h
-            if len(speeds) >= 2:
-                slope = (lams[-1] - lams[-2]) / (speeds[-1] - speeds[-2])
-                lam_pred = lams[-1] + slope * h
-            else:
-                lam_pred = lams[-1]
-            new_l, new_x, conv = self.correct_many(V1, lam_pred, vecs[-1])
-            ok = bool(conv.all())
-            if ok:
-                corr = mac(vecs[-1][: self.n_q], new_x[: self.n_q])
-                ok = bool(np.all(corr >= self.mac_min)) and not _has_duplicates(new_l)
-            scale = np.maximum(np.abs(lams[-1]), 1e-3 * np.max(np.abs(lams[-1])) + 1e-12)
-            change = np.max(np.abs(new_l - lams[-1]) / scale) if ok else np.inf
-            miss = np.max(np.abs(new_l - lam_pred) / scale) if ok else np.inf
-            if not ok or (change > 2 * max_rel_change and h > h_min):
-                h *= 0.5
-                if h < h_min:
-                    raise RuntimeError(
-                        f"eigenvalue tracking failed near V = {V:.6g} m/s: a tracked mode could "
-                        "not be continued (coalescing eigenvalues?)"
-                    )
-                continue
-            flip = new_l.imag < 0  # keep the Im >= 0 member of a pair
-            new_l[flip] = np.conj(new_l[flip])
-            new_x[:, flip] = np.conj(new_x[:, flip])
-            speeds.append(V1)
-            lams.append(new_l)
-            vecs.append(new_x)
-            V = V1
-            if progress is not None:
-                progress(V)
-            # the change grows like h and the predictor miss like h^2: aim at both targets
-            factor = min(
-                0.9 * max_rel_change / max(change, 1e-12),
-                0.9 * np.sqrt(pred_tol / max(miss, 1e-12)),
-            )
-            h = min(h * float(np.clip(factor, 0.5, 2.0)), h_max)
-        return TrackedModes(np.array(speeds), np.array(lams), np.array(vecs))
 
     def follow(
         self, speed: float, lam0: complex, x0: np.ndarray, v0: float

@@ -2,6 +2,11 @@
 
 Nodes are placed at every segment boundary and control-surface edge; the requested number of
 elements is shared among those intervals in proportion to their length (at least one each).
+Edges closer to each other (or to the root or tip) than :data:`EDGE_TOLERANCE` x span are merged
+first, so that no sliver element is built: rounding in a wing file (an aileron ending 1 mm short
+of the tip, a segment edge a few nanometres from it) would otherwise make an element thousands of
+times shorter than its neighbours. The root and tip win over segment boundaries, which win over
+control-surface edges; each merge is reported in :attr:`Mesh.warnings`.
 
 Structural unknowns per node: ``w`` (bending displacement, up) [m], ``theta`` = dw/dx [rad],
 ``phi`` (twist, nose-up) [rad], and one ``delta`` (flap rotation, trailing-edge down) [rad]
@@ -18,7 +23,10 @@ import numpy as np
 from ..errors import InputError, check_int
 from .wing import Wing
 
-__all__ = ["Mesh", "build_mesh", "LOCAL_DOFS"]
+__all__ = ["Mesh", "build_mesh", "LOCAL_DOFS", "EDGE_TOLERANCE"]
+
+EDGE_TOLERANCE = 1e-3
+"""Segment and control-surface edges closer than this fraction of the span are merged."""
 
 LOCAL_DOFS = ("w_i", "theta_i", "w_j", "theta_j", "phi_i", "phi_j", "delta_i", "delta_j")
 """Order of the 8 structural unknowns of one element (Hermite, linear twist, linear flap)."""
@@ -45,6 +53,10 @@ class Mesh:
         Flap unknown per surface and node, -1 where the surface is absent.
     dof_labels : tuple of str
         Name of each structural unknown, e.g. ``"w_3"``, ``"delta_aileron_7"``.
+    surface_extent : ndarray (n_surfaces, 2)
+        Spanwise start and end of each control surface on the mesh [m] (after merging).
+    warnings : tuple of str
+        Edges that were merged, one sentence each.
     """
 
     nodes: np.ndarray
@@ -56,6 +68,8 @@ class Mesh:
     dof_phi: np.ndarray
     dof_delta: np.ndarray
     dof_labels: tuple[str, ...]
+    surface_extent: np.ndarray = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def n_nodes(self) -> int:
@@ -87,14 +101,51 @@ class Mesh:
         return e, float(np.clip(xi, 0.0, 1.0))
 
 
-def _breakpoints(wing: Wing) -> np.ndarray:
-    pts = [0.0, wing.span]
-    pts += [s.end for s in wing.segments]
+def _edges(wing: Wing) -> tuple[list[tuple[float, int, str]], float]:
+    """Every breakpoint with its priority (0 root/tip, 1 segment edge, 2 surface edge)."""
+    span = wing.span
+    pts = [(0.0, 0, "the root"), (span, 0, "the tip")]
+    for i, seg in enumerate(wing.segments[:-1]):
+        pts.append((seg.end, 1, f"segments[{i}].end"))
     for cs in wing.control_surfaces:
-        pts += [cs.start, cs.end]
-    pts = np.unique(np.asarray(pts))
-    keep = np.r_[True, np.diff(pts) > 1e-9 * wing.span]
-    return pts[keep]
+        pts += [
+            (cs.start, 2, f"control surface '{cs.name}' start"),
+            (cs.end, 2, f"control surface '{cs.name}' end"),
+        ]
+    return sorted(pts), EDGE_TOLERANCE * span
+
+
+def _merged_edges(wing: Wing) -> tuple[dict[float, float], np.ndarray, list[str]]:
+    """Clusters of edges closer than the tolerance, each replaced by one representative.
+
+    Returns the map from every original edge to its representative, the sorted breakpoints
+    and one warning per merge.
+    """
+    pts, tol = _edges(wing)
+    clusters: list[list[tuple[float, int, str]]] = []
+    for p in pts:
+        if clusters and p[0] - clusters[-1][-1][0] < tol:
+            clusters[-1].append(p)
+        else:
+            clusters.append([p])
+    snap: dict[float, float] = {}
+    warnings = []
+    for cl in clusters:
+        best = min(c[1] for c in cl)
+        tops = [c for c in cl if c[1] == best]
+        rep = tops[0][0] if best < 2 else float(np.mean([c[0] for c in cl]))
+        if any(c[1] == 0 and c[0] == 0.0 for c in cl):
+            rep = 0.0
+        for c in cl:
+            snap[c[0]] = rep
+        moved = [c for c in cl if abs(c[0] - rep) > 1e-12 * wing.span]
+        if moved:
+            names = ", ".join(f"{c[2]} ({c[0]:.6g} m)" for c in moved)
+            warnings.append(
+                f"mesh: {names} moved to {rep:.6g} m (edges closer than "
+                f"{EDGE_TOLERANCE:g} x span = {tol:.3g} m are merged: no sliver elements)"
+            )
+    return snap, np.unique([snap[c[0]] for c in pts]), warnings
 
 
 def _allocate(lengths: np.ndarray, n: int) -> np.ndarray:
@@ -124,7 +175,15 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
     Mesh
     """
     n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
-    bp = _breakpoints(wing)
+    snap, bp, warnings = _merged_edges(wing)
+    extent = np.array([[snap[cs.start], snap[cs.end]] for cs in wing.control_surfaces])
+    extent = extent.reshape(len(wing.control_surfaces), 2)
+    for k, cs in enumerate(wing.control_surfaces):
+        if extent[k, 1] <= extent[k, 0]:
+            raise InputError(
+                f"control surface '{cs.name}': {cs.start:g} to {cs.end:g} m is shorter than the "
+                f"mesh tolerance {EDGE_TOLERANCE:g} x span = {EDGE_TOLERANCE * wing.span:.3g} m"
+            )
     if n_elements < bp.size - 1:
         raise InputError(
             f"n_elements = {n_elements}: at least {bp.size - 1} are needed to put nodes at "
@@ -138,8 +197,8 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
     seg_ends = np.array([s.end for s in wing.segments])
     segment = np.searchsorted(seg_ends, mid)
     surface = np.full(mid.size, -1)
-    for k, cs in enumerate(wing.control_surfaces):
-        surface[(mid > cs.start) & (mid < cs.end)] = k
+    for k in range(len(wing.control_surfaces)):
+        surface[(mid > extent[k, 0]) & (mid < extent[k, 1])] = k
 
     n_nodes = nodes.size
     n_surf = len(wing.control_surfaces)
@@ -155,7 +214,7 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
                 arr[i] = len(labels)
                 labels.append(f"{name}_{i}")
         for k, cs in enumerate(wing.control_surfaces):
-            if cs.start - tol <= x <= cs.end + tol:
+            if extent[k, 0] - tol <= x <= extent[k, 1] + tol:
                 dof_delta[k, i] = len(labels)
                 labels.append(f"delta_{cs.name}_{i}")
 
@@ -181,4 +240,6 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
         dof_phi=dof_phi,
         dof_delta=dof_delta,
         dof_labels=tuple(labels),
+        surface_extent=extent,
+        warnings=tuple(warnings),
     )

@@ -211,7 +211,7 @@ def _actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
             i = np.searchsorted(mesh.nodes[own + 1], x - 1e-12 * wing.span)
             e = own[min(i, own.size - 1)]
             xi = (x - mesh.nodes[e]) / (mesh.nodes[e + 1] - mesh.nodes[e])
-            n, _ = point_shapes(mesh.lengths[e], xi)
+            n, _ = point_shapes(mesh.lengths[e], float(np.clip(xi, 0.0, 1.0)))
             nd = n[2, 6:8]
             dofs = mesh.element_dofs[e, 6:8]
             for i in range(2):

@@ -1,0 +1,191 @@
+"""Branches of the modal model's eigenvalues versus speed, by a dense eigensolution at every step.
+
+At each speed every eigenvalue of the (small) modal model is computed with dense ``eig``, so no
+eigenvalue can be lost and nothing has to converge: a pair that meets its partner on the real
+axis and splits into two real roots (an exceptional point), a double real root or an
+overdamped mode needs no special treatment. Branches (one per mode at rest) are then matched
+between consecutive speeds by an optimal assignment on the distance to a linear prediction; a
+step is accepted when every complex branch is matched unambiguously, moved by less than a
+fraction of its modulus and correlates with its previous eigenvector, else it is halved.
+Where a branch is real (overdamped) its identity is that of the nearest real root and no
+ambiguity test applies: flutter crossings happen off the real axis, real roots cross zero only
+at the static divergence speeds (:mod:`aeroservo.stability.divergence`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from ..system.first_order import FirstOrderSystem
+
+__all__ = ["Branches", "sweep_branches", "is_complex"]
+
+COMPLEX = 1e-7
+"""A branch is complex (oscillatory) where ``Im(lambda) > COMPLEX |lambda|``."""
+
+
+def is_complex(lam: np.ndarray) -> np.ndarray:
+    """Whether eigenvalues are oscillatory (``Im > COMPLEX |lambda|``)."""
+    lam = np.asarray(lam)
+    return lam.imag > COMPLEX * np.abs(lam)
+
+
+@dataclass
+class Branches:
+    """Modal-model eigenvalues along each branch on the accepted speed grid.
+
+    Attributes
+    ----------
+    speeds : ndarray (n,)
+        [m/s], increasing, from 0.
+    eigenvalues : ndarray (n, m) complex
+        Branch eigenvalues [1/s] (Im >= 0).
+    vectors : ndarray (n, n_states, m) complex
+        Unit eigenvectors of the modal model.
+    spectra : list of ndarray
+        Every eigenvalue of the modal model at each speed (the certificate compares them).
+    n_ambiguous : int
+        Steps accepted at the smallest step with an ambiguous match (near coalescences).
+    stopped : str or None
+        Why the sweep ended before ``v_max`` (None: it reached it).
+    """
+
+    speeds: np.ndarray
+    eigenvalues: np.ndarray
+    vectors: np.ndarray
+    spectra: list
+    n_ambiguous: int = 0
+    stopped: str | None = None
+
+    @property
+    def n_speeds(self) -> int:
+        return self.speeds.size
+
+
+def _mac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    num = np.abs(np.sum(np.conj(x) * y, axis=0)) ** 2
+    den = np.sum(np.abs(x) ** 2, axis=0) * np.sum(np.abs(y) ** 2, axis=0)
+    return num / np.maximum(den, 1e-300)
+
+
+def sweep_branches(
+    system: FirstOrderSystem,
+    lam0: np.ndarray,
+    X0: np.ndarray,
+    v_max: float,
+    *,
+    forced: Sequence[float] = (),
+    progress: Callable[[float], None] | None = None,
+    max_rel_change: float = 0.1,
+    pred_tol: float = 1e-2,
+    mac_min: float = 0.5,
+) -> Branches:
+    """Follow the branches starting at ``(lam0, X0)`` (V = 0) up to ``v_max`` [m/s].
+
+    Parameters
+    ----------
+    system : FirstOrderSystem
+        The (modal) model; its dense state matrix is solved at every step.
+    lam0, X0 : ndarray
+        Branch eigenvalues and eigenvectors at V = 0.
+    v_max : float
+        Upper speed [m/s].
+    forced : sequence of float
+        Speeds that must be grid points (checkpoints).
+    progress : callable, optional
+        Called with each accepted speed.
+    max_rel_change : float
+        Largest change of a branch eigenvalue per step relative to its modulus (bounds how far
+        a hump can hide between grid points).
+    pred_tol : float
+        Target miss of the linear predictor relative to the modulus (fine steps where a branch
+        bends).
+    mac_min : float
+        Smallest eigenvector correlation of a complex branch between consecutive speeds.
+    """
+    a0, a1, a2 = system.state_matrix_terms()
+    h_max = v_max / 15.0
+    h = v_max / 30.0
+    h_min = v_max * 1e-6
+    h_ambiguous = v_max * 1e-4  # below this, an ambiguous match is accepted (coalescence)
+    stops = sorted({float(v) for v in forced if 0.0 < v < v_max} | {float(v_max)})
+    speeds = [0.0]
+    lams = [np.asarray(lam0, dtype=complex)]
+    vecs = [np.asarray(X0, dtype=complex)]
+    n_amb = 0
+    V = 0.0
+    w_all = [np.concatenate([lams[0], np.conj(lams[0])])]
+    while V < v_max * (1 - 1e-12):
+        nxt = next(s for s in stops if s > V * (1 + 1e-12))
+        h = min(h, nxt - V)
+        V1 = nxt if nxt - V - h < 1e-9 * v_max else V + h
+        try:
+            w, X = sla.eig(a0 + V1 * a1 + (V1 * V1) * a2)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            return _done(
+                speeds, lams, vecs, w_all, n_amb, f"eigensolution failed at {V1:.6g} m/s ({exc})"
+            )
+        if not np.all(np.isfinite(w)):
+            return _done(
+                speeds, lams, vecs, w_all, n_amb, f"non-finite eigenvalues at {V1:.6g} m/s"
+            )
+        cand = np.flatnonzero(w.imag >= 0)
+        prev = lams[-1]
+        if len(speeds) >= 2:
+            pred = prev + (prev - lams[-2]) * (V1 - V) / (V - speeds[-2])
+        else:
+            pred = prev
+        scale = np.maximum(np.abs(prev), 1e-3 * np.max(np.abs(prev)) + 1e-12)
+        cost = np.abs(w[cand][None, :] - pred[:, None]) / scale[:, None]
+        rows, cols = linear_sum_assignment(cost)
+        pick = np.empty(prev.size, dtype=int)
+        pick[rows] = cand[cols]
+        new_l = w[pick]
+        new_x = X[:, pick]
+        new_x = new_x / np.linalg.norm(new_x, axis=0)
+        osc = is_complex(new_l) & is_complex(prev)
+        change = np.abs(new_l - prev) / scale
+        miss = np.abs(new_l - pred) / scale
+        ok = bool(np.all(change <= 2 * max_rel_change))
+        if ok and osc.any():
+            d1 = cost[rows, cols]
+            c2 = cost.copy()
+            c2[rows, cols] = np.inf
+            d2 = c2.min(axis=1) if c2.shape[1] > 1 else np.full(rows.size, np.inf)
+            clear = d1 <= 0.5 * d2 + 1e-12
+            corr = _mac(vecs[-1], new_x)
+            ok = bool(np.all(clear[osc[rows]]) and np.all(corr[osc] >= mac_min))
+        too_fast = not bool(np.all(change <= 2 * max_rel_change))
+        if not ok and (h > h_ambiguous or (too_fast and h > h_min)):
+            h *= 0.5
+            continue
+        n_amb += not ok
+        speeds.append(V1)
+        lams.append(new_l)
+        vecs.append(new_x)
+        w_all.append(w)
+        V = V1
+        if progress is not None:
+            progress(V)
+        factor = min(
+            0.9 * max_rel_change / max(float(change.max()), 1e-12),
+            0.9 * np.sqrt(pred_tol / max(float(miss.max()), 1e-12)),
+        )
+        h = min(h * float(np.clip(factor, 0.5, 2.0)), h_max)
+    return _done(speeds, lams, vecs, w_all, n_amb, None)
+
+
+def _done(speeds, lams, vecs, w_all, n_amb, stopped) -> Branches:
+    return Branches(
+        speeds=np.array(speeds),
+        eigenvalues=np.array(lams),
+        vectors=np.array(vecs),
+        spectra=list(w_all),
+        n_ambiguous=n_amb,
+        stopped=stopped,
+    )

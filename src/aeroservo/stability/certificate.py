@@ -1,0 +1,208 @@
+"""The certificate of a stability sweep: the modal model misses no mode that matters.
+
+Two checks, independent of the modal model's own eigenvalues:
+
+* **In the band of the modal model** (frequencies up to 1.1 x its highest mode at rest): at
+  checkpoints along the sweep an independent spectrum is computed: the full model's, by dense
+  ``eig``, for models up to :data:`DENSE_LIMIT` states; for larger ones that of a modal model
+  with twice the modes (a modal convergence check), while every branch eigenvalue in the band
+  is recomputed on the full model by inverse iteration. Every eigenvalue of that spectrum that
+  is oscillatory and lightly damped (damping ratio below :data:`CERT_ZETA`), and every
+  unstable one at any frequency, must be an eigenvalue of the modal model to :data:`MATCH` of
+  its modulus. (Shift-invert Arnoldi on the full sparse pencil was tried and rejected: the
+  hundreds of nearly equal lag eigenvalues ``-b_i V / b`` of a fine mesh stall ARPACK.)
+* **Above the band** (:func:`truncated_modes`): every in-vacuo mode left out must have positive
+  aerodynamic damping and keep at least :data:`KEEP_FREQUENCY` of its frequency at every speed
+  up to ``v_max`` on its own (single-mode p-k estimate with the exact Theodorsen function). A
+  mode left out couples with the kept ones only if its frequency comes down towards theirs,
+  and flutters alone only with negative aerodynamic damping.
+
+A mode that fails either check joins the modal model and the sweep is redone
+(:func:`aeroservo.stability.boundary.flutter_boundary`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from .branches import Branches, is_complex
+
+__all__ = ["Certificate", "certify", "truncated_modes", "DENSE_LIMIT", "CERT_ZETA", "MATCH"]
+
+DENSE_LIMIT = 250
+"""Full models up to this many states are certified with dense ``eig``."""
+
+CERT_ZETA = 0.1
+"""Full-model eigenvalues with a damping ratio below this must be in the modal model."""
+
+MATCH = 5e-3
+"""Largest distance between a full-model eigenvalue and its modal one, relative to modulus."""
+
+KEEP_FREQUENCY = 0.8
+"""A mode left out of the modal model must keep this fraction of its in-vacuo frequency."""
+
+
+@dataclass
+class Certificate:
+    """Outcome of the checks.
+
+    Attributes
+    ----------
+    ok : bool
+    speeds : list of float
+        Checkpoints [m/s].
+    method : str
+        What the modal model was compared with.
+    max_mismatch : float
+        Largest relative distance between a checked full-model eigenvalue and its modal one.
+    missing : list of (speed, eigenvalue)
+        Full-model eigenvalues the modal model lacks.
+    n_checked : int
+        Full-model eigenvalues checked.
+    branch_error : ndarray (m,) or None
+        Largest relative distance between each branch's modal eigenvalue and the nearest
+        independent one at the checkpoints (NaN where never checked).
+    """
+
+    ok: bool = True
+    speeds: list = field(default_factory=list)
+    method: str = ""
+    max_mismatch: float = 0.0
+    missing: list = field(default_factory=list)
+    n_checked: int = 0
+    branch_error: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "ok": self.ok,
+            "checkpoints": [float(v) for v in self.speeds],
+            "method": self.method,
+            "max_mismatch": self.max_mismatch,
+            "n_checked": self.n_checked,
+            "missing": [
+                {"speed": float(v), "frequency": abs(lam.imag) / (2 * np.pi), "real": lam.real}
+                for v, lam in self.missing
+            ],
+        }
+
+
+def _relevant(lam: np.ndarray, band_top: float) -> np.ndarray:
+    """Oscillatory eigenvalues (Im > 0) in the band with a damping ratio below CERT_ZETA, and
+    unstable ones at any frequency."""
+    low = (-lam.real < CERT_ZETA * np.abs(lam)) & (lam.imag <= band_top)
+    return is_complex(lam) & (low | (lam.real >= 0))
+
+
+def certify(
+    reference: Callable[[float], np.ndarray],
+    br: Branches,
+    exact: np.ndarray,
+    values: np.ndarray,
+    checkpoints: list[int],
+    band_top: float,
+    method: str,
+) -> Certificate:
+    """Check the modal model against an independent spectrum at grid points ``checkpoints``.
+
+    Parameters
+    ----------
+    reference : callable
+        ``reference(v)``: eigenvalues at speed v [m/s] of the full model (dense eig) or, for
+        large models, of a modal model with twice the modes.
+    br : Branches
+        The modal sweep (its ``spectra`` are the modal eigenvalues at each grid point).
+    exact, values : ndarray (n_speeds, m)
+        Full-model values of the branches where computed (they replace the modal ones).
+    checkpoints : list of int
+        Grid indices to check.
+    band_top : float
+        Top of the modal model's band [rad/s].
+    method : str
+        Description of ``reference`` for the report.
+    """
+    cert = Certificate(method=method)
+    err = np.full(br.eigenvalues.shape[1], np.nan)
+    for k in checkpoints:
+        v = float(br.speeds[k])
+        cert.speeds.append(v)
+        modal = np.asarray(br.spectra[k])
+        modal = modal[modal.imag >= 0]
+        known = np.concatenate([values[k][exact[k]], modal])
+        lam_all = reference(v)
+        for j, lam_b in enumerate(br.eigenvalues[k]):
+            if exact[k, j]:
+                d = abs(values[k, j] - lam_b) / abs(lam_b)
+            elif is_complex(np.array([lam_b]))[0] and abs(lam_b) <= band_top:
+                d = float(np.min(np.abs(lam_all - lam_b))) / abs(lam_b)
+            else:
+                continue
+            err[j] = np.fmax(err[j], d)
+        lam_f = lam_all[_relevant(lam_all, band_top)]
+        cert.n_checked += lam_f.size
+        if lam_f.size == 0:
+            continue
+        cost = np.abs(lam_f[:, None] - known[None, :]) / np.abs(lam_f)[:, None]
+        rows, cols = linear_sum_assignment(cost)
+        dist = np.full(lam_f.size, np.inf)
+        dist[rows] = cost[rows, cols]
+        for lam, d in zip(lam_f, dist, strict=True):
+            if d > MATCH:
+                cert.ok = False
+                cert.missing.append((v, complex(lam)))
+            else:
+                cert.max_mismatch = max(cert.max_mismatch, float(d))
+    cert.branch_error = err
+    return cert
+
+
+def truncated_modes(model, n_kept: int, density: float, v_max: float) -> list:
+    """In-vacuo modes left out of the modal model that are not safe to leave out.
+
+    For each mode j above the modal model (mass-normalized shape phi), the single-mode p-k
+    estimate ``m p^2 + c(V, w) p + k(V, w) = 0`` with the exact Theodorsen function at
+    ``k = w b / V`` is evaluated on a speed grid up to ``v_max``; the mode is safe if its
+    aerodynamic damping c stays positive and its frequency sqrt(k/m) above
+    :data:`KEEP_FREQUENCY` of its in-vacuo one.
+
+    Returns
+    -------
+    list of (frequency [Hz], reason)
+    """
+    from ..aero.theodorsen import theodorsen_function
+    from .modal import _all_modes
+
+    freqs, phi, _labels = _all_modes(model)
+    rest = phi[:, n_kept:]
+    if rest.shape[1] == 0:
+        return []
+    am = model.matrices
+    w0 = 2 * np.pi * freqs[n_kept:]
+
+    def diag(a):
+        return np.einsum("ij,ij->j", rest, np.asarray(a @ rest))
+
+    rho = density
+    m = 1.0 + rho * diag(am.Mnc)
+    knc, cnc = diag(am.Knc), diag(am.Cnc)
+    groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
+    bad: dict[int, str] = {}
+    for V in np.linspace(v_max / 16, v_max, 16):
+        w = w0.copy()
+        for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
+            k = w0**2 + rho * V * V * knc
+            c = rho * V * cnc
+            for b, pq, pd in groups:
+                C = theodorsen_function(np.maximum(w * b / V, 1e-9))
+                F, G = C.real, C.imag
+                k = k + rho * (-V * V * F * pq + w * V * G * pd)
+                c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
+            w = np.sqrt(np.clip(k / m, 0.0, None))
+        for j in np.flatnonzero(c <= 0):
+            bad.setdefault(int(j), f"negative aerodynamic damping at {V:.4g} m/s")
+        for j in np.flatnonzero(w <= KEEP_FREQUENCY * w0):
+            bad.setdefault(int(j), f"frequency down to {w[j] / (2 * np.pi):.4g} Hz at {V:.4g} m/s")
+    return [(float(freqs[n_kept + j]), why) for j, why in sorted(bad.items())]

@@ -1,0 +1,251 @@
+"""Where the branches cross the imaginary axis, decided on the full model.
+
+The modal model's eigenvalues are accurate to about 1e-3 of their modulus, which is much
+larger than the real part of a lightly damped mode. So wherever a branch is near the axis
+(damping ratio below :data:`SIGN_ZETA`, or at an extremum below :data:`HUMP_ZETA`) its
+eigenvalue is recomputed on the full model (:class:`Verifier`, inverse iteration from the
+modal eigenpair), and every sign change and every
+hump (a real part that rises towards zero and falls back between grid points) is found by root
+finding on the full model's eigenvalue (:func:`sign_changes`, relative tolerance ``rtol``).
+Crossings are only looked for where a branch is oscillatory at both ends of a grid interval:
+real roots cross zero only at the static divergence speeds, found exactly elsewhere.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .branches import Branches, is_complex
+from .modal import ModalSystem
+from .result import Crossing
+from .tracking import EigenTracker, mac
+
+__all__ = ["HUMP_ZETA", "SIGN_ZETA", "Verifier", "sign_changes", "branch_crossings"]
+
+HUMP_ZETA = 0.05
+"""Interior extrema of Re(lambda) with |damping ratio| below this are refined between grid
+points (the step control keeps eigenvalue changes per step below 10 %, so a hump that crosses
+zero cannot hide behind grid values further from zero than this)."""
+
+SIGN_ZETA = 2e-3
+"""Branch eigenvalues with |damping ratio| below this, or below 10 x the branch's measured
+modal error (:func:`branch_crossings`), are recomputed on the full model before the sign of
+their real part is trusted; so are the grid points around every near-axis extremum."""
+
+
+class VerificationError(RuntimeError):
+    """The full model has no eigenvalue matching a modal-model branch.
+
+    Attributes
+    ----------
+    speed : float
+        [m/s]
+    eigenvalue : complex
+        The modal eigenvalue that was not confirmed [1/s].
+    """
+
+    def __init__(self, message: str, speed: float, eigenvalue: complex):
+        super().__init__(message)
+        self.speed = speed
+        self.eigenvalue = eigenvalue
+
+
+class Verifier:
+    """Full-model eigenpairs of the modal branches, computed when first needed.
+
+    Parameters
+    ----------
+    tracker : EigenTracker
+        Corrector of the full model.
+    modal : ModalSystem
+    branches : Branches
+    """
+
+    def __init__(self, tracker: EigenTracker, modal: ModalSystem, branches: Branches):
+        self.tracker = tracker
+        self.modal = modal
+        self.br = branches
+        n, m = branches.eigenvalues.shape
+        self.values = np.full((n, m), np.nan + 0j)
+        self._vec: dict[tuple[int, int], np.ndarray] = {}
+
+    @property
+    def exact(self) -> np.ndarray:
+        """Mask of the branch values computed on the full model."""
+        return np.isfinite(self.values)
+
+    def at(self, k: int, j: int) -> complex:
+        """Full-model eigenvalue of branch j at grid point k."""
+        if not np.isfinite(self.values[k, j]):
+            lam_r = complex(self.br.eigenvalues[k, j])
+            x0 = self.modal.lift(self.br.vectors[k, :, j])
+            lam, x, conv = self.tracker.correct(float(self.br.speeds[k]), lam_r, x0)
+            n_q = self.tracker.n_q
+            if not conv or mac(x0[:n_q, None], x[:n_q, None])[0] < 0.5:
+                v = self.br.speeds[k]
+                raise VerificationError(
+                    f"the full model has no eigenvalue matching the modal branch {j + 1} at "
+                    f"{v:.6g} m/s (modal {lam_r:.6g})",
+                    float(v),
+                    lam_r,
+                )
+            self.values[k, j] = lam
+            self._vec[(k, j)] = x
+        return complex(self.values[k, j])
+
+    def vector(self, k: int, j: int) -> np.ndarray:
+        """Full-model eigenvector of branch j at grid point k."""
+        self.at(k, j)
+        if (k, j) not in self._vec:  # the modal model is the full model
+            self._vec[(k, j)] = self.modal.lift(self.br.vectors[k, :, j])
+        return self._vec[(k, j)]
+
+    def follow(self, j: int, k: int, v: float) -> complex:
+        """Full-model eigenvalue of branch j at speed v, continued from grid point k."""
+        V = self.br.speeds
+        lam_k = self.at(k, j)
+        if k + 1 < V.size and np.isfinite(self.values[k + 1, j]):
+            t = (v - V[k]) / (V[k + 1] - V[k])
+            guess = lam_k + t * (self.values[k + 1, j] - lam_k)
+        else:
+            guess = lam_k
+        return self.tracker.follow(v, guess, self.vector(k, j), float(V[k]))[0]
+
+    def best(self, j: int) -> np.ndarray:
+        """Branch j on the grid: full-model values where computed, modal ones elsewhere."""
+        return np.where(self.exact[:, j], self.values[:, j], self.br.eigenvalues[:, j])
+
+
+def sign_changes(
+    fun: Callable[[float, int], float],
+    V: np.ndarray,
+    g: np.ndarray,
+    zeta: np.ndarray,
+    rtol: float,
+    first: int = 1,
+) -> list[tuple[float, bool, int]]:
+    """Roots in speed of a continuous stability measure known on a grid, humps included.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(v, k)``: the measure (e.g. Re(lambda) [1/s]) at speed v inside grid interval k.
+    V : ndarray
+        Increasing grid speeds [m/s].
+    g : ndarray
+        The measure on the grid (negative: stable).
+    zeta : ndarray
+        Damping ratio on the grid; interior extrema with ``|zeta| < HUMP_ZETA`` that do not
+        change sign on the grid are refined (a hump that crosses zero between grid points).
+    rtol : float
+        Relative tolerance on the roots.
+    first : int
+        Index of the first grid point used in the sign test (1 skips V = 0, where an undamped
+        structure has Re = 0 exactly).
+
+    Returns
+    -------
+    list of (speed, rising, k)
+        Root [m/s], whether the measure goes from negative to positive, grid interval.
+    """
+    from scipy.optimize import brentq, minimize_scalar
+
+    def root(k: int, a: float, b: float) -> float:
+        return float(brentq(fun, a, b, args=(k,), xtol=rtol * b, rtol=1e-15))
+
+    out = []
+    for k in range(first, V.size - 1):
+        if (g[k] < 0) != (g[k + 1] < 0):
+            out.append((root(k, V[k], V[k + 1]), bool(g[k] < 0), k))
+    for k in range(first + 1, V.size - 1):
+        for sgn in (1.0, -1.0):
+            gk = sgn * g
+            if not (gk[k] >= gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
+                continue
+            if abs(zeta[k]) >= HUMP_ZETA:
+                continue
+            # search both grid intervals around the extreme, continuing from the left one
+            sol = minimize_scalar(
+                lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
+                bounds=(V[k - 1], V[k + 1]),
+                method="bounded",
+                options={"xatol": rtol * V[k + 1]},
+            )
+            if -sol.fun > 0:
+                vpk = float(sol.x)
+                kk = k - 1 if vpk < V[k] else k
+                out.append((root(kk, V[kk], vpk), sgn > 0, kk))
+                out.append((root(kk, vpk, V[kk + 1]), sgn < 0, kk))
+    return sorted(out)
+
+
+def _extrema(g: np.ndarray) -> np.ndarray:
+    """Interior local maxima and minima of a grid function."""
+    k = np.arange(1, g.size - 1)
+    mx = (g[k] >= g[k - 1]) & (g[k] >= g[k + 1])
+    mn = (g[k] <= g[k - 1]) & (g[k] <= g[k + 1])
+    return k[mx | mn]
+
+
+def branch_crossings(
+    ver: Verifier, j: int, rtol: float, error: float = 0.0, band_top: float = np.inf
+) -> list[Crossing]:
+    """Onsets and recoveries of branch j (full-model speeds and frequencies).
+
+    Parameters
+    ----------
+    ver : Verifier
+    j : int
+        Branch.
+    rtol : float
+        Relative tolerance on the crossing speeds.
+    error : float
+        Measured error of the branch's modal eigenvalues relative to their modulus (the
+        certificate's); signs are trusted where ``|zeta| > max(SIGN_ZETA, 10 error)``.
+    band_top : float
+        Top of the modal model's band [rad/s]: above it a branch is not decided here (the
+        modes above the band are certified on their own, see
+        :func:`aeroservo.stability.certificate.truncated_modes`).
+    """
+    br = ver.br
+    V = br.speeds
+    lam_r = br.eigenvalues[:, j]
+    osc = is_complex(lam_r) & (np.abs(lam_r) <= band_top)
+    zeta_r = -lam_r.real / np.maximum(np.abs(lam_r), 1e-300)
+    trust = max(SIGN_ZETA, 10.0 * error)
+    todo = set(np.flatnonzero(osc & (np.abs(zeta_r) < trust)).tolist())
+    for k in _extrema(lam_r.real):
+        if osc[k - 1 : k + 2].all() and abs(zeta_r[k]) < HUMP_ZETA + trust:
+            todo |= {int(k - 1), int(k), int(k + 1)}
+    for k in sorted(todo):
+        if k > 0:
+            ver.at(int(k), j)
+    out: list[Crossing] = []
+    # runs of consecutive oscillatory grid points
+    k = 0
+    while k < V.size:
+        if not osc[k]:
+            k += 1
+            continue
+        a = k
+        while k + 1 < V.size and osc[k + 1]:
+            k += 1
+        b = k
+        k += 1
+        if b - a < 1:
+            continue
+        idx = np.arange(a, b + 1)
+        lam = ver.best(j)[idx]
+        g = lam.real
+        zeta = -g / np.maximum(np.abs(lam), 1e-300)
+
+        def fun(v: float, kk: int, idx=idx) -> float:
+            return float(ver.follow(j, int(idx[kk]), v).real)
+
+        for v, rising, kk in sign_changes(fun, V[idx], g, zeta, rtol, first=1 if a == 0 else 0):
+            lam_c = ver.follow(j, int(idx[kk]), v)
+            kind = "onset" if rising else "recovery"
+            out.append(Crossing(float(v), abs(lam_c.imag) / (2 * np.pi), j, kind))
+    return out

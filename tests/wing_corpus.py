@@ -1,0 +1,531 @@
+"""Seeded, randomized corpus of wings for validating the stability engine.
+
+Plain functions, no pytest: :func:`corpus` returns a deterministic list of :class:`Case` for a
+seed. Property ranges are built around the Goland wing (:func:`aeroservo.examples.goland`) and
+its illustrative aileron (``AILERON`` in ``aeroservo.structure.examples``); the HALE class is
+built around the Patil-Hodges-Cesnik wing (``tests/data/reference_cases.json`` case id
+``hale_patil_hodges_cesnik``: span 16 m, chord 1 m, EA and CG at mid-chord, EI 2e4, GJ 1e4,
+0.75 kg/m, 0.1 kg m, 0.0889 kg/m^3).
+
+Each case's ``v_max`` puts its interesting instability inside the range: the generator scans
+the eigenvalues of the state matrix on a coarse grid (counts of unstable oscillatory and
+positive real eigenvalues; :func:`scan_events`) and sets ``v_max`` to 1.3-2 times the speed of
+the instability the class is about (every second HALE case: 2.6-3.2 times its flutter speed, so
+that the range also holds the post-divergence region where real roots merge into unstable
+complex pairs). That coarse scan only chooses the range; the tests compare
+the engine with their own fine reference.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from threadpoolctl import threadpool_limits
+
+import aeroservo as aes
+from aeroservo.structure.examples import AILERON, GOLAND_SEMICHORD, GOLAND_SPAN
+
+__all__ = ["Case", "CLASSES", "case_names", "corpus", "scan_events", "uncoupled_frequencies"]
+
+SEED = 20261201
+
+GOLAND = {
+    "semichord": GOLAND_SEMICHORD,
+    "a": -0.34,
+    "mass": 35.71,
+    "x_alpha": 0.2,
+    "inertia": 8.64,
+    "EI": 9.77e6,
+    "GJ": 0.99e6,
+}
+"""Goland wing section (SI), as in :func:`aeroservo.examples.goland`."""
+
+GOLAND_R2 = GOLAND["inertia"] / (GOLAND["mass"] * GOLAND["semichord"] ** 2)
+"""Goland radius of gyration about the elastic axis squared, in semichords^2 (about 0.29)."""
+
+HALE = {"span": 16.0, "semichord": 0.5, "mass": 0.75, "inertia": 0.1, "EI": 2.0e4, "GJ": 1.0e4}
+"""Patil-Hodges-Cesnik HALE wing (reference case ``hale_patil_hodges_cesnik``)."""
+
+HALE_DENSITY = 0.0889  # kg/m^3, 20 km altitude
+
+CLASSES = {
+    "multi_segment": 5,
+    "hale": 4,
+    "flap_soft": 4,
+    "flap_stiff": 4,
+    "two_flaps": 4,
+    "actuators_only": 4,
+    "cg_ahead": 4,
+    "ea_ahead_of_qc": 4,
+    "divergence_critical": 4,
+    "near_coincident": 4,
+    "hump": 3,
+}
+"""Number of cases per class."""
+
+MAX_DRAWS = 400
+"""Draws per case before the generator gives up (a generator bug, not an engine finding)."""
+
+SCAN_POINTS = 160
+"""Grid points of the coarse scan that chooses v_max."""
+
+
+@dataclass(frozen=True)
+class Case:
+    """One corpus case: a model, the air density [kg/m^3] and the upper speed [m/s]."""
+
+    name: str
+    klass: str
+    model: aes.AeroelasticModel
+    density: float
+    v_max: float
+
+
+@dataclass(frozen=True)
+class Draw:
+    """A candidate wing before its speed range is fixed."""
+
+    wing: aes.Wing
+    density: float
+    n_elements: int
+
+
+# --------------------------------------------------------------------------------------------
+# coarse scan (chooses v_max only)
+
+
+def _counts(model: aes.AeroelasticModel, density: float, v: float) -> tuple[int, int]:
+    """Unstable oscillatory eigenvalues (Im > 0) and positive real eigenvalues at speed v."""
+    lam = sla.eigvals(model.state_matrix(v, density))
+    mag = np.abs(lam)
+    osc = (lam.imag > 1e-6 * mag) & (mag > 1e-9)
+    real = np.abs(lam.imag) <= 1e-6 * mag
+    return int(np.sum(osc & (lam.real > 0))), int(np.sum(real & (lam.real > 0)))
+
+
+def scan_events(
+    model: aes.AeroelasticModel, density: float, v_top: float, n: int = SCAN_POINTS
+) -> list[tuple[float, str]]:
+    """Approximate stability events on a uniform grid of ``n`` speeds on (0, v_top].
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    density : float
+        Air density [kg/m^3].
+    v_top : float
+        Upper end of the scan [m/s].
+    n : int
+        Grid points.
+
+    Returns
+    -------
+    list of (speed, kind)
+        Mid-interval speed [m/s] and ``"onset"`` / ``"recovery"`` (the number of unstable
+        oscillatory eigenvalues goes up / down) or ``"divergence"`` (the number of positive
+        real eigenvalues goes up), in increasing speed. Merges of real roots are not told apart
+        from crossings here.
+    """
+    speeds = np.linspace(v_top / n, v_top, n)
+    counts = [_counts(model, density, v) for v in speeds]
+    events = []
+    for i in range(n - 1):
+        v = 0.5 * (speeds[i] + speeds[i + 1])
+        (u0, r0), (u1, r1) = counts[i], counts[i + 1]
+        events += [(v, "onset")] * max(u1 - u0, 0) + [(v, "recovery")] * max(u0 - u1, 0)
+        events += [(v, "divergence")] * max(r1 - r0, 0)
+    return events
+
+
+def _v_top(model: aes.AeroelasticModel) -> float:
+    """Upper speed of the coarse scan [m/s]: 6 b omega of the first torsion mode."""
+    modes = model.natural_modes(min(8, model.n_dofs))
+    omega = 2 * np.pi * modes.frequencies
+    torsion = [w for w, lab in zip(omega, modes.labels, strict=True) if "torsion" in lab]
+    ref = torsion[0] if torsion else omega[min(1, omega.size - 1)]
+    return float(6.0 * model.semichord * ref)
+
+
+def uncoupled_frequencies(section: dict, span: float) -> tuple[float, float]:
+    """Uncoupled first bending and torsion frequencies [rad/s] of a uniform cantilever.
+
+    Parameters
+    ----------
+    section : dict
+        ``mass`` [kg/m], ``inertia`` [kg m], ``EI``, ``GJ`` [N m^2].
+    span : float
+        Span [m].
+    """
+    w_b = 1.875104**2 / span**2 * np.sqrt(section["EI"] / section["mass"])
+    w_t = np.pi / (2 * span) * np.sqrt(section["GJ"] / section["inertia"])
+    return float(w_b), float(w_t)
+
+
+# --------------------------------------------------------------------------------------------
+# building blocks
+
+
+def _u(rng: np.random.Generator, lo: float, hi: float) -> float:
+    return float(rng.uniform(lo, hi))
+
+
+def _inertia(mass: float, semichord: float, x_alpha: float, r2: float) -> float:
+    """Pitch inertia about the EA [kg m] from r^2 [semichords^2], above m (x_alpha b)^2."""
+    return mass * semichord**2 * max(r2, x_alpha**2 + 0.05)
+
+
+def _goland_section(rng: np.random.Generator, spread: float = 0.2, **fixed: float) -> dict:
+    """Goland section with every property scaled by U(1 - spread, 1 + spread).
+
+    ``a`` and ``x_alpha`` are drawn around Goland's unless given in ``fixed``; the inertia
+    follows from a radius of gyration around Goland's.
+    """
+    s = {k: GOLAND[k] * _u(rng, 1 - spread, 1 + spread) for k in ("semichord", "mass", "EI", "GJ")}
+    s["a"] = _u(rng, -0.45, -0.25)
+    s["x_alpha"] = _u(rng, 0.05, 0.3)
+    s.update(fixed)
+    r2 = GOLAND_R2 * _u(rng, 1 - spread, 1 + spread)
+    s["inertia"] = fixed.get("inertia", _inertia(s["mass"], s["semichord"], s["x_alpha"], r2))
+    return s
+
+
+def _segment(start: float, end: float, s: dict, name: str = "segment") -> aes.Segment:
+    return aes.Segment(
+        start=start,
+        end=end,
+        semichord=s["semichord"],
+        a=s["a"],
+        mass=s["mass"],
+        x_alpha=s["x_alpha"],
+        inertia=s["inertia"],
+        EI=s["EI"],
+        GJ=s["GJ"],
+        name=name,
+    )
+
+
+def _span_interval(rng: np.random.Generator, where: str, span: float) -> tuple[float, float]:
+    """Spanwise extent [m] of a control surface: inboard, mid or outboard."""
+    if where == "inboard":
+        f0, f1 = _u(rng, 0.05, 0.15), _u(rng, 0.4, 0.5)
+    elif where == "mid":
+        f0, f1 = _u(rng, 0.3, 0.4), _u(rng, 0.65, 0.75)
+    else:  # to the tip, or ending well short of it (an edge 1 cm from the tip is a sliver)
+        f0, f1 = _u(rng, 0.55, 0.7), (1.0 if rng.uniform() < 0.5 else _u(rng, 0.88, 0.93))
+    return f0 * span, f1 * span
+
+
+def _flap(
+    rng: np.random.Generator,
+    name: str,
+    start: float,
+    end: float,
+    semichord: float,
+    balance: str,
+    flap_hz: float,
+    actuators: int = 0,
+) -> aes.ControlSurface:
+    """A trailing-edge surface around the Goland aileron (``AILERON``).
+
+    Parameters
+    ----------
+    balance : str
+        ``"unbalanced"`` (flap CG 30-60 % of the flap chord aft of the hinge, S_beta > 0),
+        ``"balanced"`` (S_beta = 0) or ``"overbalanced"`` (CG ahead of the hinge, S_beta < 0).
+    flap_hz : float
+        Uncoupled flap frequency [Hz] that sets the hinge stiffness (or the actuators).
+    actuators : int
+        0: distributed hinge spring only; 1-2: actuators only (hinge stiffness 0), at stations
+        drawn inside the surface.
+    """
+    hinge = _u(rng, 0.45, 0.7)
+    chord = semichord * (1.0 - hinge)  # flap chord [m]
+    mass = 2.0 * _u(rng, 0.5, 2.0)  # kg/m (the Goland aileron has 2 kg/m)
+    if balance == "unbalanced":
+        d = _u(rng, 0.3, 0.6) * chord
+    elif balance == "balanced":
+        d = 0.0
+    else:
+        d = -_u(rng, 0.05, 0.25) * chord
+    static_moment = mass * d
+    inertia = mass * (_u(rng, 0.06, 0.2) * chord**2 + d * d)
+    k = inertia * (2 * np.pi * flap_hz) ** 2  # N m/rad per m
+    acts: tuple[aes.Actuator, ...] = ()
+    hinge_stiffness = k
+    if actuators:
+        hinge_stiffness = 0.0
+        length = end - start
+        total = k * length
+        stations = sorted(
+            _u(rng, start + 0.05 * length, end - 0.05 * length) for _ in range(actuators)
+        )
+        acts = tuple(
+            aes.Actuator(station=x, stiffness=total / actuators, name=f"{name}_act{i + 1}")
+            for i, x in enumerate(stations)
+        )
+    return aes.ControlSurface(
+        name=name,
+        start=start,
+        end=end,
+        hinge=hinge,
+        static_moment=static_moment,
+        inertia=inertia,
+        GJ=AILERON["GJ"] * _u(rng, 0.3, 2.0),
+        hinge_stiffness=hinge_stiffness,
+        actuators=acts,
+    )
+
+
+def _n_elements(rng: np.random.Generator) -> int:
+    return int(rng.integers(8, 15))
+
+
+def _goland_density(rng: np.random.Generator) -> float:
+    return _u(rng, 0.4, 1.225)
+
+
+# --------------------------------------------------------------------------------------------
+# one drawing function per class
+
+
+def _draw_multi_segment(rng: np.random.Generator, k: int) -> Draw:
+    n_seg = 2 + k % 3
+    cuts = np.sort(rng.uniform(0.15, 0.85, n_seg - 1))
+    while np.any(np.diff(np.r_[0.0, cuts, 1.0]) < 0.15):
+        cuts = np.sort(rng.uniform(0.15, 0.85, n_seg - 1))
+    edges = np.r_[0.0, cuts, 1.0] * GOLAND_SPAN
+    bounds = {"EI": (0.15, 6.0), "GJ": (0.15, 6.0), "mass": (0.15, 6.0), "semichord": (0.22, 2.2)}
+    s = _goland_section(rng)
+    segs = []
+    for i in range(n_seg):
+        if i > 0:
+            s = dict(s)
+            for key, (lo, hi) in bounds.items():
+                s[key] = _jump(rng, s[key], lo * GOLAND[key], hi * GOLAND[key])
+            s["a"] = _u(rng, -0.45, -0.2)
+            s["x_alpha"] = _u(rng, 0.05, 0.3)
+            r2 = GOLAND_R2 * _u(rng, 0.8, 1.2)
+            s["inertia"] = _inertia(s["mass"], s["semichord"], s["x_alpha"], r2)
+        segs.append(_segment(edges[i], edges[i + 1], s, name=f"segment{i + 1}"))
+    wing = aes.Wing(GOLAND_SPAN, segs, name=f"multi-segment ({n_seg})")
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _jump(rng: np.random.Generator, value: float, lo: float, hi: float) -> float:
+    """``value`` times or divided by a factor in [2, 5], staying inside [lo, hi]."""
+    for _ in range(100):
+        f = _u(rng, 2.0, 5.0)
+        options = [v for v in (value * f, value / f) if lo <= v <= hi]
+        if options:
+            return float(options[int(rng.integers(len(options)))])
+    raise RuntimeError(f"no jump by a factor 2-5 keeps {value:g} inside [{lo:g}, {hi:g}]")
+
+
+def _draw_hale(rng: np.random.Generator, k: int) -> Draw:
+    s = {key: HALE[key] * _u(rng, 0.7, 1.3) for key in ("mass", "inertia", "EI", "GJ")}
+    s.update(semichord=HALE["semichord"], a=0.0, x_alpha=0.0)
+    wing = aes.Wing(HALE["span"], [_segment(0.0, HALE["span"], s, "hale")], name="HALE")
+    return Draw(wing, HALE_DENSITY * _u(rng, 0.7, 1.3), _n_elements(rng))
+
+
+_BALANCE = ("unbalanced", "balanced", "overbalanced")
+_WHERE = ("inboard", "mid", "outboard")
+
+
+def _one_flap_wing(rng: np.random.Generator, k: int, flap_hz: float, actuators: int = 0):
+    s = _goland_section(rng)
+    x0, x1 = _span_interval(rng, _WHERE[k % 3], GOLAND_SPAN)
+    balance = _BALANCE[(k + k // 3) % 3]
+    cs = _flap(rng, "flap", x0, x1, s["semichord"], balance, flap_hz, actuators)
+    seg = _segment(0.0, GOLAND_SPAN, s, "goland")
+    return aes.Wing(GOLAND_SPAN, [seg], [cs], name=f"flap {balance} {_WHERE[k % 3]}")
+
+
+def _draw_flap_soft(rng: np.random.Generator, k: int) -> Draw:
+    wing = _one_flap_wing(rng, k, _u(rng, 2.0, 8.0))
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _draw_flap_stiff(rng: np.random.Generator, k: int) -> Draw:
+    wing = _one_flap_wing(rng, k, _u(rng, 25.0, 60.0))
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _draw_actuators_only(rng: np.random.Generator, k: int) -> Draw:
+    wing = _one_flap_wing(rng, k, _u(rng, 5.0, 40.0), actuators=1 + k % 2)
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _draw_two_flaps(rng: np.random.Generator, k: int) -> Draw:
+    s = _goland_section(rng)
+    b = s["semichord"]
+    span = GOLAND_SPAN
+    inner = (_u(rng, 0.1, 0.25) * span, _u(rng, 0.45, 0.55) * span)
+    outer = (_u(rng, 0.6, 0.65) * span, (1.0 if k % 2 else _u(rng, 0.88, 0.93)) * span)
+    hz = [_u(rng, 2.0, 8.0) if (k + i) % 2 == 0 else _u(rng, 25.0, 50.0) for i in range(2)]
+    flaps = [
+        _flap(rng, "inboard", *inner, b, _BALANCE[k % 3], hz[0]),
+        _flap(rng, "outboard", *outer, b, _BALANCE[(k + 1) % 3], hz[1], actuators=k % 2),
+    ]
+    wing = aes.Wing(span, [_segment(0.0, span, s, "goland")], flaps, name="two flaps")
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _clean(rng: np.random.Generator, name: str, **fixed: float) -> Draw:
+    s = _goland_section(rng, **fixed)
+    wing = aes.Wing(GOLAND_SPAN, [_segment(0.0, GOLAND_SPAN, s, "goland")], name=name)
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _draw_cg_ahead(rng: np.random.Generator, k: int) -> Draw:
+    return _clean(rng, "CG ahead of EA", x_alpha=-_u(rng, 0.05, 0.3))
+
+
+def _draw_ea_ahead_of_qc(rng: np.random.Generator, k: int) -> Draw:
+    return _clean(rng, "EA ahead of 1/4 chord", a=_u(rng, -0.8, -0.55), x_alpha=_u(rng, 0.1, 0.4))
+
+
+def _draw_divergence_critical(rng: np.random.Generator, k: int) -> Draw:
+    # with the CG at or aft of an aft elastic axis a flutter onset comes first; CG ahead of it
+    return _clean(rng, "EA well aft", a=_u(rng, 0.0, 0.4), x_alpha=-_u(rng, 0.05, 0.3))
+
+
+def _draw_near_coincident(rng: np.random.Generator, k: int) -> Draw:
+    s = _goland_section(rng)
+    w_b, _ = uncoupled_frequencies(s, GOLAND_SPAN)
+    w_t = w_b * (1.0 + _u(rng, -0.04, 0.04))
+    s["GJ"] = s["inertia"] * (2 * GOLAND_SPAN * w_t / np.pi) ** 2
+    wing = aes.Wing(GOLAND_SPAN, [_segment(0.0, GOLAND_SPAN, s, "goland")], name="coincident")
+    return Draw(wing, _goland_density(rng), _n_elements(rng))
+
+
+def _draw_hump(rng: np.random.Generator, k: int) -> Draw:
+    """A soft, mass-unbalanced flap at low density (clean wings with a low mass ratio showed no
+    hump below divergence in a search of 150 draws; a far-forward elastic axis gives only wide
+    humps at 200-600 m/s)."""
+    s = _goland_section(rng, spread=0.15)
+    x0, x1 = _span_interval(rng, ("outboard", "mid")[k % 2], GOLAND_SPAN)
+    cs = _flap(rng, "flap", x0, x1, s["semichord"], "unbalanced", _u(rng, 2.0, 8.0))
+    seg = _segment(0.0, GOLAND_SPAN, s, "goland")
+    wing = aes.Wing(GOLAND_SPAN, [seg], [cs], name="hump (soft flap)")
+    return Draw(wing, _u(rng, 0.3, 0.6), _n_elements(rng))
+
+
+DRAWS: dict[str, Callable[[np.random.Generator, int], Draw]] = {
+    "multi_segment": _draw_multi_segment,
+    "hale": _draw_hale,
+    "flap_soft": _draw_flap_soft,
+    "flap_stiff": _draw_flap_stiff,
+    "two_flaps": _draw_two_flaps,
+    "actuators_only": _draw_actuators_only,
+    "cg_ahead": _draw_cg_ahead,
+    "ea_ahead_of_qc": _draw_ea_ahead_of_qc,
+    "divergence_critical": _draw_divergence_critical,
+    "near_coincident": _draw_near_coincident,
+    "hump": _draw_hump,
+}
+
+
+# --------------------------------------------------------------------------------------------
+# the speed range of a class
+
+
+def _target(klass: str, events: list[tuple[float, str]]) -> float | None:
+    """Speed [m/s] of the instability the class is about (v_max is 1.3-2x it), or None to
+    redraw."""
+    if not events:
+        return None
+    first_v, first_kind = events[0]
+    if klass in ("multi_segment", "hale", "near_coincident", "ea_ahead_of_qc"):
+        return first_v if first_kind == "onset" else None  # flutter first
+    if klass == "divergence_critical":
+        return first_v if first_kind == "divergence" else None
+    if klass == "hump":
+        return _hump_end(events)
+    return first_v
+
+
+def _hump_end(events: list[tuple[float, str]]) -> float | None:
+    """Recovery speed of an onset followed by a recovery below any divergence, or None."""
+    n, onset = 0, None
+    for v, kind in events:
+        if kind == "divergence":
+            return None
+        if kind == "onset":
+            n += 1
+            onset = v if onset is None else onset
+        elif kind == "recovery":
+            n -= 1
+            if n == 0 and onset is not None and v - onset > 0.03 * v:
+                return v
+    return None
+
+
+def _no_sliver(model: aes.AeroelasticModel) -> bool:
+    """No element shorter than a fifth of the longest (edges close together make slivers)."""
+    h = np.diff(model.mesh.nodes)
+    return bool(h.min() >= 0.2 * h.max())
+
+
+def _actuators_off_nodes(model: aes.AeroelasticModel) -> bool:
+    """Every actuator at least 2 % of its element length away from a mesh node."""
+    nodes = model.mesh.nodes
+    h = float(np.min(np.diff(nodes)))
+    for cs in model.wing.control_surfaces:
+        for act in cs.actuators:
+            if np.min(np.abs(nodes - act.station)) < 0.02 * h:
+                return False
+    return True
+
+
+def _case(rng: np.random.Generator, klass: str, k: int) -> Case:
+    """The k-th case of a class: draw until the wing is valid and its instability found."""
+    draw_fn = DRAWS[klass]
+    for _ in range(MAX_DRAWS):
+        try:
+            draw = draw_fn(rng, k)
+        except aes.InputError:
+            continue  # e.g. a flap mass matrix that is not positive definite: redraw
+        model = aes.AeroelasticModel(draw.wing, n_elements=draw.n_elements)
+        if not _no_sliver(model):
+            continue
+        if klass == "actuators_only" and not _actuators_off_nodes(model):
+            continue
+        target = _target(klass, scan_events(model, draw.density, _v_top(model)))
+        if target is None:
+            continue
+        factor = _u(rng, 2.6, 3.2) if klass == "hale" and k % 2 else _u(rng, 1.3, 2.0)
+        v_max = float(np.round(target * factor, 3))
+        return Case(case_name(klass, k), klass, model, float(draw.density), v_max)
+    raise RuntimeError(f"wing_corpus: no valid {klass} case in {MAX_DRAWS} draws")
+
+
+def case_name(klass: str, k: int) -> str:
+    """Name of the k-th case (from 0) of a class, e.g. ``"hale_02"`` for k = 1."""
+    return f"{klass}_{k + 1:02d}"
+
+
+def case_names() -> list[str]:
+    """Names of the corpus cases in corpus order, known without building the corpus."""
+    return [case_name(klass, k) for klass, n in CLASSES.items() for k in range(n)]
+
+
+def corpus(seed: int = SEED) -> list[Case]:
+    """The validation corpus for a seed (deterministic: same seed, same cases).
+
+    Parameters
+    ----------
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+
+    Returns
+    -------
+    list of Case
+        ``sum(CLASSES.values())`` cases, class by class in the order of :data:`CLASSES`.
+    """
+    rng = np.random.default_rng(seed)
+    with threadpool_limits(1):  # small dense eigenproblems: one BLAS thread is fastest
+        return [_case(rng, klass, k) for klass, n in CLASSES.items() for k in range(n)]
