@@ -5,6 +5,10 @@
 2. The same for 100 elements (target: < 1 s), model assembly reported separately.
 3. Whole process ``aeroservo flutter goland --json`` versus ``python -c "import numpy,
    scipy.linalg"`` (target: <= 3x).
+4. A 16-altitude flutter envelope (0-15 km, incompressible) versus one one-altitude boundary
+   on a fresh model of the same wing (target: <= 20 such boundaries: the density-independent
+   matrices are built once); the Prandtl-Glauert envelope (matched Mach at every altitude)
+   is reported too.
 
 Run: ``make bench`` (or ``python bench/bench_flutter.py``). Medians of repeated runs.
 """
@@ -61,6 +65,27 @@ def whole_process(repeats: int) -> dict:
     }
 
 
+def envelope_cost() -> dict:
+    from aeroservo.studies.envelope import flutter_envelope
+
+    alts = [1000.0 * k for k in range(16)]
+
+    def one():
+        aes.flutter_boundary(aes.AeroelasticModel(aes.examples.goland(), 10), 1.225)
+
+    def env(comp):
+        flutter_envelope(
+            aes.AeroelasticModel(aes.examples.goland(), 10), alts, compressibility=comp
+        )
+
+    one()
+    return {
+        "one_s": median_time(one, 5),
+        "env_s": median_time(lambda: env(None), 3),
+        "env_pg_s": median_time(lambda: env("prandtl-glauert"), 1),
+    }
+
+
 def main() -> None:
     print("aeroservo flutter benchmarks (medians; ratios to baselines of the same run)")
     for n, reps in ((10, 15), (100, 3)):
@@ -74,6 +99,14 @@ def main() -> None:
             f"({r['eig_s'] * 1e3:.2f} ms); assembly {r['build_s'] * 1e3:.1f} ms "
             f"[{target}: {'PASS' if ok else 'FAIL'}]"
         )
+    e = envelope_cost()
+    ratio = e["env_s"] / e["one_s"]
+    print(
+        f"  16-altitude envelope: {e['env_s']:.3f} s = {ratio:.1f} x one boundary "
+        f"({e['one_s'] * 1e3:.1f} ms, fresh model) [target <= 20: "
+        f"{'PASS' if ratio <= 20 else 'FAIL'}]; with Prandtl-Glauert (matched Mach) "
+        f"{e['env_pg_s']:.2f} s = {e['env_pg_s'] / e['one_s']:.0f} x"
+    )
     w = whole_process(5)
     ratio = w["cli_s"] / w["import_s"]
     print(

@@ -56,7 +56,7 @@ MODULES = {module_name(p): p for p in sorted(SRC.rglob("*.py"))}
 def stage(mod: str) -> str:
     if mod in BASE:
         return "base"
-    if mod in ("aeroservo", "aeroservo.__main__", "aeroservo.cli"):
+    if mod in ("aeroservo", "aeroservo.__main__") or mod.startswith("aeroservo.cli"):
         return "cli"
     if mod == "aeroservo.plots":
         return "plots"

@@ -75,10 +75,22 @@ def test_input_errors_exit_2(argv, msg, capsys):
     assert msg in err and err.count("\n") == 1
 
 
-def test_usage_errors_exit_2():
-    with pytest.raises(SystemExit) as exc:
-        main(["flutter", "goland", "--density", "-1"])
-    assert exc.value.code == 2
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["flutter", "goland", "--density", "-1"],
+        ["flutter"],
+        ["nonsense"],
+        ["flutter", "goland", "--no-such-option"],
+        [],
+    ],
+)
+def test_usage_errors_exit_2_in_one_line(argv, capsys):
+    """argparse's usage errors are one line too (not the usage dump), exit 2."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and err.startswith("aeroservo: error: ")
+    assert "--help" in err
 
 
 def test_modes_and_examples(capsys):

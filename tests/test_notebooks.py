@@ -25,6 +25,7 @@ EXPECTED = {
     "02_lqr_lqg_design.ipynb",
     "03_mpc_vs_saturated_lqr.ipynb",
     "04_trade_study.ipynb",
+    "05_flutter_clearance.ipynb",
 }
 KERNEL = "python3"
 

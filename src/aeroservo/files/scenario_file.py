@@ -10,17 +10,15 @@ limits against the initial state); every error names the file, the key and the v
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
-import numpy as np
-
-from ..design.spec import ControllerSpec
 from ..errors import InputError
-from ..studies.scenario import GUST_KEYS, GUST_TYPES, SCENARIO_KINDS, Disturbance, Scenario
-from .controller_file import load_controller
+from ..stability.matched import COMPRESSIBILITY
+from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .scenario_checks import cross_check
+from .scenario_tables import controller, disturbance, flight, is_file, trade_table
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
+from .wing_file import damping_from_dict
 
 __all__ = ["load_scenario", "scenario_from_dict", "is_scenario_file", "shipped_scenarios"]
 
@@ -35,21 +33,24 @@ TOP = (
     "simulation",
     "analysis",
     "output",
+    "damping",
     "trade",
 )
 USED = {
-    "flutter": ("scenario", "wing", "flight", "model", "analysis", "output"),
+    "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping"),
     "simulate": TOP[:-1],
-    "trade": ("scenario", "wing", "flight", "model", "signals", "simulation", "output", "trade"),
+    "trade": (
+        "scenario",
+        "wing",
+        "flight",
+        "model",
+        "signals",
+        "simulation",
+        "output",
+        "damping",
+        "trade",
+    ),
 }
-
-
-def _is_file(path: Path) -> bool:
-    """``path.is_file()``, False for names the OS rejects (e.g. too long)."""
-    try:
-        return path.is_file()
-    except (OSError, ValueError):
-        return False
 
 
 def _surface_keys(message: str, data: object, where: str) -> str:
@@ -76,78 +77,23 @@ def _wing(tbl: Table, base: Path):
             tbl.fail("file", tbl.data["file"], "give either builtin or file, not both")
         if tbl.has("builtin"):
             name = tbl.string("builtin", choices=sorted(BUILTIN_WINGS))
-            return BUILTIN_WINGS[name](), f"builtin {name}"
+            return BUILTIN_WINGS[name](), f"builtin {name}", None
         path = tbl.path("file", base)
-        if not _is_file(path):
+        if not is_file(path):
             tbl.fail("file", tbl.data["file"], f"no such wing file ({path})")
         data = None
         try:
             data = read_toml(path).get("wing")
-            return load_wing(path)[0], str(path)
+            wing, opts = load_wing(path)
+            return wing, str(path), (opts.damping if opts.damping.active else None)
         except InputError as exc:
             msg = _surface_keys(str(exc), data, "wing")
             raise InputError(f"{tbl.file}: {tbl.key_name('file')} -> {msg}") from None
     try:
-        return wing_from_dict(tbl.data, tbl.where), "inline"
+        return wing_from_dict(tbl.data, tbl.where), "inline", None
     except InputError as exc:
         msg = _surface_keys(str(exc), tbl.data, tbl.where)
         raise InputError(f"{tbl.file}: {msg}") from None
-
-
-def _disturbance(tbl: Table, base: Path, span: float) -> Disturbance:
-    from ..aero.gusts import GustSeries, OneMinusCosine, Turbulence
-
-    kind = tbl.string("gust", "none", choices=GUST_TYPES)
-    tbl.check_keys((), ("initial_tip", "gust") + GUST_KEYS[kind])
-    tip = tbl.number("initial_tip", 0.0, unit="m", lo=-0.25 * span, hi=0.25 * span)
-    gust = None
-    if kind == "one_minus_cosine":
-        gust = OneMinusCosine(
-            length=tbl.number("length", unit="m", lo=0.0, lo_open=True, required=True),
-            amplitude=tbl.number("amplitude", unit="m/s", lo=-50.0, hi=50.0, required=True),
-            start=tbl.number("start", 0.0, unit="s", lo=0.0),
-        )
-    elif kind == "turbulence":
-        gust = Turbulence(
-            sigma=tbl.number("sigma", unit="m/s", lo=0.0, hi=30.0, required=True),
-            scale=tbl.number("scale", 533.0, unit="m", lo=0.0, lo_open=True),
-            model=tbl.string("model", "von_karman", choices=("von_karman", "dryden")),
-            seed=tbl.integer("seed", 0, lo=0, hi=2**32 - 1),
-        )
-    elif kind == "series":
-        path = tbl.path("file", base, required=True)
-        gust = _gust_series(tbl, path, GustSeries)
-    return Disturbance(initial_tip=tip, gust=gust)
-
-
-def _gust_series(tbl: Table, path: Path, cls):
-    """CSV with columns time [s], velocity [m/s] (a header line is allowed)."""
-    if not _is_file(path):
-        tbl.fail("file", tbl.data["file"], f"no such gust file ({path})")
-    rows = []
-    try:
-        with path.open(newline="", encoding="utf-8") as fh:
-            for i, row in enumerate(csv.reader(fh)):
-                if not row or row[0].strip().startswith("#"):
-                    continue
-                try:
-                    rows.append((float(row[0]), float(row[1])))
-                except (ValueError, IndexError):
-                    if i == 0:
-                        continue  # header
-                    tbl.fail("file", tbl.data["file"], f"line {i + 1}: expected time, velocity")
-    except UnicodeDecodeError:
-        tbl.fail("file", tbl.data["file"], "not a UTF-8 text file")
-    except csv.Error as exc:
-        tbl.fail("file", tbl.data["file"], f"not a CSV file: {exc}")
-    except OSError as exc:
-        tbl.fail("file", tbl.data["file"], f"cannot read the gust file: {exc.strerror}")
-    t = np.array([r[0] for r in rows])
-    w = np.array([r[1] for r in rows])
-    try:
-        return cls(tuple(t), tuple(w))
-    except InputError as exc:
-        tbl.fail("file", tbl.data["file"], str(exc))
 
 
 def scenario_from_dict(data: object, file: str = "<dict>", base: Path | None = None) -> Scenario:
@@ -174,11 +120,13 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         "source": file,
         "description": sc.string("description", ""),
     }
-    kw["wing"], kw["wing_source"] = _wing(top.table("wing"), base)
+    kw["wing"], kw["wing_source"], wing_damping = _wing(top.table("wing"), base)
     wing = kw["wing"]
 
-    fl = top.table("flight").check_keys(("density",), ("speed", "speed_factor"))
-    kw["density"] = fl.number("density", unit="kg/m^3", lo=0.0, hi=2.0, lo_open=True, required=True)
+    fl = top.table("flight").check_keys(
+        (), ("density", "altitude", "altitude_ft", "speed", "speed_factor")
+    )
+    flight(fl, kw)
     if fl.has("speed") and fl.has("speed_factor"):
         fl.fail("speed_factor", fl.data["speed_factor"], "give speed or speed_factor, not both")
     kw["speed"] = fl.number("speed", unit="m/s", lo=0.0, hi=1000.0, lo_open=True)
@@ -187,8 +135,26 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         raise InputError(f"{file}: flight.speed: missing; give speed [m/s] or speed_factor")
 
     md = top.table("model").check_keys(
-        (), ("elements", "wagner", "design_modes", "gust", "v_max", "pk")
+        (), ("elements", "wagner", "design_modes", "gust", "v_max", "pk", "compressibility")
     )
+    comp = md.string("compressibility", "none", choices=COMPRESSIBILITY)
+    if comp != "none":
+        if kind != "flutter":
+            md.fail(
+                "compressibility",
+                comp,
+                "only flutter scenarios take it (use 'aeroservo envelope' or a flutter scenario)",
+            )
+        if kw["altitude"] is None:
+            md.fail("compressibility", comp, "needs flight.altitude or flight.altitude_ft")
+        kw["compressibility"] = comp
+    if top.has("damping"):
+        try:
+            kw["damping"] = damping_from_dict(top.data["damping"], "damping")
+        except InputError as exc:
+            raise InputError(f"{file}: {exc}") from None
+    elif wing_damping is not None:
+        kw["damping"] = wing_damping
     kw["elements"] = md.integer("elements", 10, lo=1, hi=400)
     try:
         build_mesh(wing, kw["elements"])
@@ -241,73 +207,16 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["plots"] = out.boolean("plots", True)
 
     if kind == "simulate":
-        kw["disturbance"] = _disturbance(top.table("disturbance"), base, wing.span)
+        kw["disturbance"] = disturbance(top.table("disturbance"), base, wing.span)
         ct = top.table("controller", required=True).check_keys(("spec",))
         spec_path = ct.path("spec", base, required=True)
-        kw["controller"] = _controller(ct, spec_path)
+        kw["controller"] = controller(ct, spec_path)
     if kind == "trade":
-        kw["trade"] = _trade_table(top.table("trade", required=True), base)
+        kw["trade"] = trade_table(top.table("trade", required=True), base)
 
     scenario = Scenario(**kw)
     cross_check(scenario, top)
     return scenario
-
-
-def _controller(ct: Table, path: Path, key: str = "spec") -> ControllerSpec:
-    """The controller file ``path`` named by ``key``; its errors also name this file."""
-    if not _is_file(path):
-        ct.fail(key, ct.data[key], f"no such controller file ({path})")
-    try:
-        return load_controller(path)
-    except InputError as exc:
-        raise InputError(f"{ct.file}: {ct.key_name(key)} -> {exc}") from None
-
-
-def _trade_table(tbl: Table, base: Path) -> dict:
-    """Raw trade settings; validated against the wing by :mod:`aeroservo.studies.trade`."""
-    from ..studies.trade.study import PARAMETERS
-
-    tbl.check_keys(
-        ("controller", "parameters"),
-        (
-            "speed_factor",
-            "gust_length",
-            "gust_amplitude",
-            "gust_duration",
-            "v_max_factor",
-            "n_grid",
-            "workers",
-        ),
-    )
-    spec = _controller(tbl, tbl.path("controller", base, required=True), "controller")
-    if spec.type not in ("lqr", "lqg"):
-        tbl.fail(
-            "controller",
-            tbl.data["controller"],
-            f"a trade study needs a linear controller (lqr or lqg), this one is {spec.type!r}",
-        )
-    pt = tbl.table("parameters").check_keys((), tuple(PARAMETERS))
-    params = {}
-    for name in pt.data:
-        params[name] = tuple(pt.numbers(name, lo=0.0, lo_open=name != "hinge_stiffness"))
-        if len(set(params[name])) != len(params[name]):
-            pt.fail(name, pt.data[name], "values must not repeat")
-    if not params:
-        tbl.fail("parameters", tbl.data["parameters"], f"give at least one of {list(PARAMETERS)}")
-    n_cases = int(np.prod([len(v) for v in params.values()]))
-    if n_cases > 1_000_000:
-        tbl.fail("parameters", tbl.data["parameters"], f"{n_cases} cases: the limit is 1 000 000")
-    return {
-        "controller": spec,
-        "parameters": params,
-        "speed_factor": tbl.number("speed_factor", 1.1, lo=0.0, hi=10.0, lo_open=True),
-        "gust_length": tbl.number("gust_length", 25.0, unit="m", lo=0.0, lo_open=True),
-        "gust_amplitude": tbl.number("gust_amplitude", 5.0, unit="m/s", lo=-50.0, hi=50.0),
-        "gust_duration": tbl.number("gust_duration", 1.0, unit="s", lo=0.0, hi=60.0, lo_open=True),
-        "v_max_factor": tbl.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True),
-        "n_grid": tbl.integer("n_grid", 21, lo=3, hi=2000),
-        "workers": tbl.integer("workers", 2, lo=1, hi=256),
-    }
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -1,29 +1,44 @@
 """Wing description files (TOML, schema in ``docs/wing-file.md``).
 
 A file has a ``[wing]`` table (``span``, ``[[wing.segments]]``, optional
-``[[wing.control_surfaces]]`` with ``[[wing.control_surfaces.actuators]]``) and an optional
-``[analysis]`` table with defaults for ``density``, ``elements``, ``wagner``, ``v_max`` and
-``n_modes``. Every error names the file, the key and the value.
+``[[wing.control_surfaces]]`` with ``[[wing.control_surfaces.actuators]]``), an optional
+``[analysis]`` table with defaults for ``density`` or ``altitude`` / ``altitude_ft``,
+``compressibility``, ``elements``, ``wagner``, ``v_max`` and ``n_modes``, and an optional
+``[damping]`` table (``ratio``, ``alpha`` and ``beta``, or ``g``). Every error names the file,
+the key and the value.
 """
 
 from __future__ import annotations
 
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..aero.atmosphere import isa, isa_ft
 from ..aero.indicial import wagner_set
 from ..errors import InputError, check_int, check_number
+from ..stability.matched import COMPRESSIBILITY
 from ..structure.wing import Actuator, ControlSurface, Segment, Wing
+from ..system.damping import NO_DAMPING, StructuralDamping
 
-__all__ = ["AnalysisOptions", "load_wing", "wing_from_dict", "resolve_wing"]
+__all__ = ["AnalysisOptions", "load_wing", "wing_from_dict", "resolve_wing", "damping_from_dict"]
 
 SEGMENT_KEYS = ("start", "end", "semichord", "a", "mass", "x_alpha", "inertia", "EI", "GJ")
 SURFACE_REQUIRED = ("name", "start", "end", "hinge", "static_moment", "inertia")
 SURFACE_OPTIONAL = ("GJ", "hinge_stiffness", "actuators")
 ACTUATOR_KEYS = ("station", "stiffness")
-ANALYSIS_KEYS = ("density", "elements", "wagner", "v_max", "n_modes")
+ANALYSIS_KEYS = (
+    "density",
+    "altitude",
+    "altitude_ft",
+    "compressibility",
+    "elements",
+    "wagner",
+    "v_max",
+    "n_modes",
+)
+DAMPING_KEYS = ("ratio", "alpha", "beta", "g")
 
 
 @dataclass(frozen=True)
@@ -41,7 +56,13 @@ class AnalysisOptions:
     v_max : float or None
         Upper end of the speed search [m/s] (default: automatic).
     n_modes : int or None
-        Tracked modes (default: automatic).
+        Fewest modes of the modal model (default: automatic).
+    altitude : float or None
+        Geopotential altitude [m] (standard atmosphere; replaces ``density``).
+    compressibility : str or None
+        ``"prandtl-glauert"`` (Mach matched at the altitude) or None.
+    damping : StructuralDamping
+        Structural damping (default none).
     """
 
     density: float = 1.225
@@ -49,6 +70,9 @@ class AnalysisOptions:
     wagner: object = "rt_jones"
     v_max: float | None = None
     n_modes: int | None = None
+    altitude: float | None = None
+    compressibility: str | None = None
+    damping: StructuralDamping = NO_DAMPING
 
 
 def _check_keys(where: str, table: object, required: tuple, optional: tuple = ()) -> Mapping:
@@ -116,10 +140,34 @@ def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOption
     """Build :class:`AnalysisOptions` from the ``[analysis]`` table."""
     tbl = _check_keys(where, data, (), ANALYSIS_KEYS)
     opts = {}
+    given = [k for k in ("density", "altitude", "altitude_ft") if k in tbl]
+    if len(given) > 1:
+        raise InputError(
+            f"{where}.{given[1]} = {tbl[given[1]]!r}: give one of density, altitude, altitude_ft"
+        )
     if "density" in tbl:
         opts["density"] = check_number(
             f"{where}.density", tbl["density"], unit="kg/m^3", lo=0.0, lo_open=True
         )
+    if "altitude" in tbl or "altitude_ft" in tbl:
+        key = given[0]
+        try:
+            atm = isa(tbl[key]) if key == "altitude" else isa_ft(tbl[key])
+        except InputError as exc:
+            raise InputError(f"{where}.{exc}") from None
+        opts["altitude"], opts["density"] = atm.altitude, atm.density
+    if "compressibility" in tbl:
+        comp = tbl["compressibility"]
+        if comp not in COMPRESSIBILITY:
+            raise InputError(
+                f"{where}.compressibility = {comp!r}: allowed values are {list(COMPRESSIBILITY)}"
+            )
+        if comp != "none" and "altitude" not in opts:
+            raise InputError(
+                f"{where}.compressibility = {comp!r}: needs altitude or altitude_ft (the speed "
+                "of sound)"
+            )
+        opts["compressibility"] = None if comp == "none" else comp
     if "elements" in tbl:
         opts["elements"] = check_int(f"{where}.elements", tbl["elements"], lo=1, hi=100_000)
     if "wagner" in tbl:
@@ -132,6 +180,27 @@ def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOption
     if "n_modes" in tbl:
         opts["n_modes"] = check_int(f"{where}.n_modes", tbl["n_modes"], lo=1)
     return AnalysisOptions(**opts)
+
+
+def damping_from_dict(data: Mapping, where: str = "damping") -> StructuralDamping:
+    """Structural damping from a ``[damping]`` table: ``ratio`` (a number or a list, one per
+    in-vacuo mode), ``alpha`` and ``beta`` (Rayleigh), or ``g`` (structural damping)."""
+    tbl = _check_keys(where, data, (), DAMPING_KEYS)
+    forms = [k for k in ("ratio", "g") if k in tbl] + (
+        ["alpha/beta"] if "alpha" in tbl or "beta" in tbl else []
+    )
+    if len(forms) > 1:
+        raise InputError(f"{where}: give one of ratio, g, or alpha and beta (given {forms})")
+    try:
+        if "ratio" in tbl:
+            return StructuralDamping.modal(tbl["ratio"])
+        if "g" in tbl:
+            return StructuralDamping.structural(tbl["g"])
+        if forms:
+            return StructuralDamping.rayleigh(tbl.get("alpha", 0.0), tbl.get("beta", 0.0))
+    except InputError as exc:
+        raise InputError(str(exc).replace("damping.", f"{where}.", 1)) from None
+    return NO_DAMPING
 
 
 def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
@@ -160,8 +229,11 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
     try:
-        _check_keys("(top level)", data, ("wing",), ("analysis",))
-        return wing_from_dict(data["wing"]), analysis_from_dict(data.get("analysis", {}))
+        _check_keys("(top level)", data, ("wing",), ("analysis", "damping"))
+        opts = analysis_from_dict(data.get("analysis", {}))
+        if "damping" in data:
+            opts = replace(opts, damping=damping_from_dict(data["damping"]))
+        return wing_from_dict(data["wing"]), opts
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
 

@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from .._threads import blas_limited
 from ..aero.indicial import IndicialSet, kussner_set
 from ..errors import InputError, check_number
-from ..system.first_order import first_order
+from ..system.first_order import check_mach, compressibility_factors, first_order
 from .servo import Servo, servos_of
 from .signals import (
     Sensor,
@@ -107,6 +107,14 @@ class StateSpaceBuilder:
     n_modes : int, optional
         Modal truncation of the structure: keep this many in-vacuo modes (the lag states stay
         complete and consistent with the projected downwash). Default: no truncation.
+    mach : float
+        Mach number of the Prandtl-Glauert correction (0: incompressible): circulatory and gust
+        loads x 1/beta, lag and Kussner rates x beta^2 (:mod:`aeroservo.system.first_order`).
+
+    Notes
+    -----
+    The model's structural damping (``model.damping``) is part of the plant; it is not counted
+    in the aerodynamic outputs (``<surface>_aero_hinge_moment``).
     """
 
     @blas_limited
@@ -121,6 +129,7 @@ class StateSpaceBuilder:
         gust: str = "kussner",
         kussner: object = "sears_sparks",
         n_modes: int | None = None,
+        mach: float = 0.0,
     ):
         self.model = model
         self.density = rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
@@ -150,7 +159,9 @@ class StateSpaceBuilder:
         def vec(v: np.ndarray) -> np.ndarray:  # generalized force / row in the used unknowns
             return v if basis is None else basis.T @ v
 
-        system = first_order(am, model.wagner, rho, model.semichord)
+        self.mach = check_mach(mach)
+        cf, beta2 = compressibility_factors(self.mach)
+        system = first_order(am, model.wagner, rho, model.semichord, mach=self.mach)
         self.system = system
         n_q = am.n_q
         T = model.wagner.n_terms
@@ -175,12 +186,14 @@ class StateSpaceBuilder:
 
         # aerodynamic generalized forces (without apparent mass) on the free and root unknowns
         wag = model.wagner
-        scale = 1.0 - sum(wag.A)
-        ab = np.asarray(wag.A) * np.asarray(wag.b)
+        scale = cf * (1.0 - sum(wag.A))
+        ab = cf * beta2 * np.asarray(wag.A) * np.asarray(wag.b)
         rt = am.root
         Fa = np.zeros((3, n_q, n))
         Fa[:, :, :n0] = A[:, iv, :n0]
         Fa[0, :, iq] += _dense(am.Ks)
+        if am.Cs is not None:  # structural damping is not an aerodynamic force
+            Fa[0, :, iv] += _dense(am.Cs)
         Fr = np.zeros((3, 3, n))
         Fr[2, :, iq] = -rho * _dense(rt.Knc - scale * rt.Pq)
         Fr[1, :, iv] = -rho * _dense(rt.Cnc - scale * rt.Pd)
@@ -198,12 +211,12 @@ class StateSpaceBuilder:
                 for gi, g in enumerate(groups):
                     for t in range(kus.n_terms):
                         s = ig.start + gi * kus.n_terms + t
-                        A[1, s, s] = -kb[t] / g.b
+                        A[1, s, s] = -kb[t] * beta2 / g.b
                         B[0, s, j] = 1.0
-                        Fa[2, :, s] = rho * ka[t] * kb[t] * g.Gw
-                        Fr[2, :, s] = rho * ka[t] * kb[t] * rt.circ_groups[gi].Gw
+                        Fa[2, :, s] = rho * cf * beta2 * ka[t] * kb[t] * g.Gw
+                        Fr[2, :, s] = rho * cf * beta2 * ka[t] * kb[t] * rt.circ_groups[gi].Gw
                         g_states.append(f"g{t + 1}_b{gi}")
-                direct = 1.0 - ka.sum()
+                direct = cf * (1.0 - ka.sum())
             else:
                 B[0, iz, j] = np.kron(np.asarray(am.Mz1.sum(axis=1)).ravel(), np.ones(T))
                 direct = scale
@@ -212,6 +225,8 @@ class StateSpaceBuilder:
 
         A[:, iv, :] = Fa
         A[0, iv, iq] -= _dense(am.Ks)
+        if am.Cs is not None:
+            A[0, iv, iv] -= _dense(am.Cs)
         B[:, iv, :] = Fu
 
         # control inputs and servo states

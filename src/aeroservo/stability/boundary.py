@@ -51,7 +51,9 @@ MAX_ENLARGE = 3
 """Times the certificate may enlarge the modal model before the full model is used."""
 
 
-def _as_system(model: object, density: float | None) -> tuple[FirstOrderSystem, object]:
+def _as_system(
+    model: object, density: float | None, mach: float = 0.0
+) -> tuple[FirstOrderSystem, object]:
     """The full first-order system, and the model it comes from (None for a bare system)."""
     if isinstance(model, FirstOrderSystem):
         return model, None
@@ -63,7 +65,7 @@ def _as_system(model: object, density: float | None) -> tuple[FirstOrderSystem, 
     if density is None:
         raise InputError("density = None: give the air density [kg/m^3]")
     rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-    return model.system(rho), model
+    return model.system(rho, mach), model
 
 
 def default_v_max(semichord: float, omega_2: float, v_div: np.ndarray) -> float:
@@ -95,6 +97,7 @@ def flutter_boundary(
     rtol: float = 1e-7,
     progress: Callable[[float], None] | None = None,
     exact_branches: bool = False,
+    mach: float = 0.0,
 ) -> FlutterResult:
     """Flutter and divergence boundaries of a model at one air density.
 
@@ -120,14 +123,18 @@ def flutter_boundary(
     exact_branches : bool
         Recompute every branch value on the full model (by default only those near the
         imaginary axis are; the others are the modal model's, to about 1e-3).
+    mach : float
+        Mach number of the Prandtl-Glauert correction (0: incompressible), fixed over the
+        sweep; :func:`aeroservo.stability.matched.flutter_at_altitude` finds the matched point.
 
     Returns
     -------
     FlutterResult
     """
-    system, src = _as_system(model, density)
+    system, src = _as_system(model, density, mach)
     n_min = MIN_MODES if n_modes is None else check_int("n_modes", n_modes, lo=1, hi=system.n_q)
     rtol = check_number("rtol", rtol, lo=1e-14, hi=1e-2)
+    rho, mach = system.density, system.mach
     warnings = list(getattr(getattr(src, "mesh", None), "warnings", ()))
     v_div = divergence_speeds(system)
     if src is None:
@@ -139,7 +146,7 @@ def flutter_boundary(
         v_max = default_v_max(system.semichord, omega_2, v_div)
     v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
     tracker = EigenTracker(system)
-    basis = _checked_basis(src, n_min, system.density, v_max) if src is not None else None
+    basis = _checked_basis(src, n_min, rho, v_max, mach) if src is not None else None
     crossings: list[Crossing] | None = None
     for attempt in range(MAX_ENLARGE + 1):
         modal = _modal(src, system, basis, n_modes)
@@ -165,7 +172,7 @@ def flutter_boundary(
             f"({basis.n_modes} modes, band up to {basis.cutoff:.4g} Hz) lacked or misplaced; "
             f"swept again with the band up to {cutoff:.4g} Hz"
         )
-        basis = _checked_basis(src, n_min, system.density, v_max, cutoff)
+        basis = _checked_basis(src, n_min, rho, v_max, mach, cutoff)
     if not cert.ok:
         warnings.append(
             "the certificate still finds full-model eigenvalues the modal model lacks: "
@@ -213,16 +220,21 @@ def flutter_boundary(
         searched_up_to=top,
         warnings=warnings,
         exact=exact,
+        mach=mach,
+        compressibility="prandtl-glauert" if mach > 0 else None,
+        damping=_damping_text(src),
     )
 
 
-def _checked_basis(src, n_min: int, rho: float, v_max: float, cutoff=None) -> ModalBasis:
+def _checked_basis(
+    src, n_min: int, rho: float, v_max: float, mach: float, cutoff=None
+) -> ModalBasis:
     """The rule's modes, plus every mode the truncation check cannot leave out."""
     basis = modal_basis(src, n_min, cutoff)
     notes = []
     for _ in range(8):
         n_band = int(np.sum(basis.frequencies <= basis.cutoff * (1 + 1e-9)))
-        bad = truncated_modes(src, n_band, rho, v_max)
+        bad = truncated_modes(src, n_band, rho, v_max, mach)
         if not bad:
             break
         f_bad, why = max(bad)
@@ -236,7 +248,7 @@ def _checked_basis(src, n_min: int, rho: float, v_max: float, cutoff=None) -> Mo
 def _modal(src, system: FirstOrderSystem, basis: ModalBasis | None, n_modes) -> ModalSystem:
     if src is None:
         return ModalSystem(system, None, None, 0)
-    return modal_system(src, system.density, basis)
+    return modal_system(src, system.density, basis, system.mach)
 
 
 def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progress):
@@ -262,7 +274,7 @@ def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progres
 
     else:
         n_big = min(2 * m, full.n_q)
-        big = modal_system(src, full.density, modal_basis(src, n_big)).system
+        big = modal_system(src, full.density, modal_basis(src, n_big), full.mach).system
         method = f"modal model of {n_big} modes; branches in the band verified on the full model"
 
         def reference(v: float) -> np.ndarray:
@@ -357,6 +369,11 @@ def _labels(src, modal: ModalSystem, br: Branches) -> list[str]:
 
 def modal_n_q(src) -> int:
     return src.matrices.n_q
+
+
+def _damping_text(src) -> str:
+    damping = getattr(src, "damping", None)
+    return damping.describe() if damping is not None else "none"
 
 
 def _modal_info(modal: ModalSystem) -> dict:

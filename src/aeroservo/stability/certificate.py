@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from ..system.first_order import compressibility_factors
 from .branches import Branches, is_complex
 
 __all__ = ["Certificate", "certify", "truncated_modes", "DENSE_LIMIT", "CERT_ZETA", "MATCH"]
@@ -159,14 +160,15 @@ def certify(
     return cert
 
 
-def truncated_modes(model, n_kept: int, density: float, v_max: float) -> list:
+def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: float = 0.0) -> list:
     """In-vacuo modes left out of the modal model that are not safe to leave out.
 
     For each mode j above the modal model (mass-normalized shape phi), the single-mode p-k
     estimate ``m p^2 + c(V, w) p + k(V, w) = 0`` with the exact Theodorsen function at
     ``k = w b / V`` is evaluated on a speed grid up to ``v_max``; the mode is safe if its
     aerodynamic damping c stays positive and its frequency sqrt(k/m) above
-    :data:`KEEP_FREQUENCY` of its in-vacuo one.
+    :data:`KEEP_FREQUENCY` of its in-vacuo one. With compressibility, ``C(k / beta^2) / beta``
+    (:mod:`aeroservo.system.first_order`).
 
     Returns
     -------
@@ -186,6 +188,7 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float) -> list:
         return np.einsum("ij,ij->j", rest, np.asarray(a @ rest))
 
     rho = density
+    cf, beta2 = compressibility_factors(mach)
     m = 1.0 + rho * diag(am.Mnc)
     knc, cnc = diag(am.Knc), diag(am.Cnc)
     groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
@@ -196,7 +199,7 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float) -> list:
             k = w0**2 + rho * V * V * knc
             c = rho * V * cnc
             for b, pq, pd in groups:
-                C = theodorsen_function(np.maximum(w * b / V, 1e-9))
+                C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
                 F, G = C.real, C.imag
                 k = k + rho * (-V * V * F * pq + w * V * G * pd)
                 c = c + rho * (-V * F * pd - (V * V * G / w) * pq)

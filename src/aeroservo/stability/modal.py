@@ -232,14 +232,15 @@ def _project_lags(am: AeroMatrices, Q: np.ndarray) -> AeroMatrices:
     )
 
 
-def modal_system(model, density: float, basis: ModalBasis | None) -> ModalSystem:
-    """The modal model of ``model`` at ``density`` [kg/m^3] on ``basis`` (None: the full model).
+def modal_system(model, density: float, basis: ModalBasis | None, mach: float = 0.0) -> ModalSystem:
+    """The modal model of ``model`` at ``density`` [kg/m^3] and compressibility Mach number
+    ``mach`` on ``basis`` (None: the full model).
 
     The projected matrices are cached on the model per basis, so other densities only rescale.
     """
     wagner = wagner_set(model.wagner)
     if basis is None or basis.n_modes >= model.matrices.n_q:
-        return ModalSystem(model.system(density), None, None, wagner.n_terms)
+        return ModalSystem(model.system(density, mach), None, None, wagner.n_terms)
     cache = model.__dict__.setdefault("_modal_cache", {})
     key = ("matrices", basis.n_modes)
     if key not in cache:
@@ -249,7 +250,7 @@ def modal_system(model, density: float, basis: ModalBasis | None) -> ModalSystem
             am = _project_lags(am, Q)
         cache[key] = (am, Q)
     am, Q = cache[key]
-    skey = ("system", basis.n_modes, float(density))
+    skey = ("system", basis.n_modes, float(density), float(mach))
     if skey not in cache:
-        cache[skey] = first_order(am, wagner, density, model.semichord)
+        cache[skey] = first_order(am, wagner, density, model.semichord, mach=mach)
     return ModalSystem(cache[skey], basis, Q, wagner.n_terms)

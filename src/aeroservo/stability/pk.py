@@ -24,6 +24,7 @@ import scipy.linalg as sla
 from .._threads import blas_limited
 from ..aero.theodorsen import theodorsen_function
 from ..errors import check_int, check_number
+from ..system.first_order import check_mach, compressibility_factors
 from ..system.matrices import AeroMatrices
 from .boundary import default_v_max
 from .divergence import static_speeds
@@ -42,16 +43,21 @@ class _PK:
     Cnc: np.ndarray
     groups: list
     rho: float
+    Cs: np.ndarray | None = None
+    cf: float = 1.0
+    beta2: float = 1.0
 
     def frozen(self, V: float, w: float) -> tuple[np.ndarray, np.ndarray]:
         """Stiffness and damping with the aerodynamics frozen at frequency ``w`` [rad/s]."""
         rho = self.rho
         K = self.Ks + rho * V * V * self.Knc
         C = rho * V * self.Cnc
+        if self.Cs is not None:
+            C = C + self.Cs
         if V > 0:
             w_eff = max(w, 1e-9)
             for b, Pq, Pd in self.groups:
-                c = theodorsen_function(max(w_eff * b / V, 1e-9))
+                c = theodorsen_function(max(w_eff * b / (V * self.beta2), 1e-9)) * self.cf
                 F, G = c.real, c.imag
                 K = K + rho * (-V * V * F * Pq + w_eff * V * G * Pd)
                 C = C + rho * (-V * F * Pd - (V * V * G / w_eff) * Pq)
@@ -123,10 +129,11 @@ class PKConvergenceError(RuntimeError):
     """The p-k iteration found no consistent frequency for a branch."""
 
 
-def _setup(am: AeroMatrices, rho: float) -> tuple[_PK, np.ndarray]:
+def _setup(am: AeroMatrices, rho: float, mach: float = 0.0) -> tuple[_PK, np.ndarray]:
     """p-k matrices in the complete basis of in-vacuo modes (an exact change of variables that
     makes the stiffness diagonal and keeps round-off relative to each mode's own scale)."""
     _, phi = sla.eigh(am.Ks.toarray(), am.Ms.toarray())
+    cf, beta2 = compressibility_factors(mach)
 
     def modal(a):
         return phi.T @ (a.toarray() @ phi)
@@ -138,14 +145,19 @@ def _setup(am: AeroMatrices, rho: float) -> tuple[_PK, np.ndarray]:
         Cnc=modal(am.Cnc),
         groups=[(g.b, modal(g.Pq), modal(g.Pd)) for g in am.circ_groups],
         rho=rho,
+        Cs=None if am.Cs is None else modal(am.Cs),
+        cf=cf,
+        beta2=beta2,
     )
     return pk, phi
 
 
-def static_divergence_speed(am: AeroMatrices, density: float) -> float | None:
-    """Lowest divergence speed [m/s] with the exact steady strip aerodynamics (C = 1), or None
-    (robust to round-off: :func:`aeroservo.stability.divergence.static_speeds`)."""
-    v = static_speeds(am.Ks.toarray(), am.Knc.toarray() - am.Pq.toarray(), density)
+def static_divergence_speed(am: AeroMatrices, density: float, mach: float = 0.0) -> float | None:
+    """Lowest divergence speed [m/s] with the exact steady strip aerodynamics (C = 1, with the
+    Prandtl-Glauert factor at ``mach``), or None (robust to round-off:
+    :func:`aeroservo.stability.divergence.static_speeds`)."""
+    cf, _ = compressibility_factors(mach)
+    v = static_speeds(am.Ks.toarray(), am.Knc.toarray() - cf * am.Pq.toarray(), density)
     return float(v[0]) if v.size else None
 
 
@@ -158,6 +170,7 @@ def pk_flutter(
     n_modes: int | None = None,
     n_speeds: int = 41,
     rtol: float = 1e-7,
+    mach: float = 0.0,
 ) -> FlutterResult:
     """Flutter boundary by the p-k method with the exact Theodorsen function.
 
@@ -177,6 +190,9 @@ def pk_flutter(
         Uniform grid points from 0 to ``v_max`` (crossings are then found by root finding).
     rtol : float
         Relative tolerance on crossing speeds.
+    mach : float
+        Mach number of the Prandtl-Glauert correction, ``C(k) -> C(k / beta^2) / beta``
+        (0: incompressible).
 
     Returns
     -------
@@ -189,10 +205,11 @@ def pk_flutter(
         n_modes = modal_basis(model).n_modes
     n_modes = check_int("n_modes", n_modes, lo=1, hi=am.n_q)
     n_speeds = check_int("n_speeds", n_speeds, lo=3)
-    pk, basis = _setup(am, rho)
+    mach = check_mach(mach)
+    pk, basis = _setup(am, rho, mach)
     w2, phi = sla.eigh(pk.Ks, pk.M, subset_by_index=[0, n_modes - 1])
     p0 = 1j * np.sqrt(w2)
-    v_divs = static_speeds(am.Ks.toarray(), am.Knc.toarray() - am.Pq.toarray(), rho)
+    v_divs = static_speeds(am.Ks.toarray(), am.Knc.toarray() - pk.cf * am.Pq.toarray(), rho)
     v_div = float(v_divs[0]) if v_divs.size else None
     if v_max is None:
         b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
@@ -254,4 +271,7 @@ def pk_flutter(
             "branches_ended_at": ended,
             "unconfirmed_sign_changes_at": skipped,
         },
+        mach=mach,
+        compressibility="prandtl-glauert" if mach > 0 else None,
+        damping=getattr(getattr(model, "damping", None), "describe", lambda: "none")(),
     )

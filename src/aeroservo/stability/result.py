@@ -1,10 +1,17 @@
-"""Results of a stability analysis versus airspeed: crossings, tracked branches, summaries."""
+"""Results of a stability analysis versus airspeed: crossings, tracked branches, summaries.
+
+Speeds are true airspeeds (TAS) [m/s]; every flutter and divergence speed is also given as an
+equivalent airspeed (EAS), a Mach number when the speed of sound is known (an altitude was
+given), and in knots (KTAS, KEAS) (:mod:`aeroservo.aero.atmosphere`).
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ..aero.atmosphere import KNOT, RHO0
 
 __all__ = ["Crossing", "FlutterResult"]
 
@@ -63,6 +70,16 @@ class FlutterResult:
     exact : ndarray (n_speeds, n_modes) of bool or None
         Which branch values are eigenvalues of the full model (the others come from the modal
         model, accurate to about 1e-3 of their modulus); None: all are.
+    altitude : float or None
+        Geopotential altitude [m] of the flight condition (None: only the density is known).
+    speed_of_sound : float or None
+        [m/s]; None when only the density is known (no Mach numbers then).
+    mach : float
+        Mach number of the aerodynamics (Prandtl-Glauert correction; 0: incompressible).
+    compressibility : str or None
+        ``"prandtl-glauert"`` or None.
+    damping : str
+        Structural damping of the model (e.g. ``"g = 0.03"``, ``"none"``).
     info : dict
         Method details (modal model, certificate, counts), JSON-ready.
     """
@@ -79,6 +96,11 @@ class FlutterResult:
     searched_up_to: float | None = None
     warnings: list = field(default_factory=list)
     exact: np.ndarray | None = None
+    altitude: float | None = None
+    speed_of_sound: float | None = None
+    mach: float = 0.0
+    compressibility: str | None = None
+    damping: str = "none"
 
     def __post_init__(self) -> None:
         if self.searched_up_to is None:
@@ -125,14 +147,61 @@ class FlutterResult:
         f = self.flutter
         return None if f is None else self.mode_labels[f.mode]
 
+    def eas(self, speed: float | None) -> float | None:
+        """Equivalent airspeed [m/s] of a true airspeed [m/s] at this density."""
+        return None if speed is None else float(speed * np.sqrt(self.density / RHO0))
+
+    def mach_of(self, speed: float | None) -> float | None:
+        """Mach number of a true airspeed [m/s], or None without a speed of sound."""
+        if speed is None or self.speed_of_sound is None:
+            return None
+        return float(speed / self.speed_of_sound)
+
+    @property
+    def flutter_eas(self) -> float | None:
+        """Flutter speed as an equivalent airspeed [m/s]."""
+        return self.eas(self.flutter_speed)
+
+    @property
+    def flutter_mach(self) -> float | None:
+        """Flutter Mach number (None without a speed of sound)."""
+        return self.mach_of(self.flutter_speed)
+
+    @property
+    def divergence_eas(self) -> float | None:
+        """Divergence speed as an equivalent airspeed [m/s]."""
+        return self.eas(self.divergence_speed)
+
+    @property
+    def divergence_mach(self) -> float | None:
+        """Divergence Mach number (None without a speed of sound)."""
+        return self.mach_of(self.divergence_speed)
+
     def to_dict(self) -> dict:
-        """JSON-ready summary (SI units: m/s, Hz, kg/m^3)."""
+        """JSON-ready summary (SI units: m/s, Hz, kg/m^3; knots in the ``*_kt*`` keys)."""
+
+        def kt(v):
+            return None if v is None else v / KNOT
+
         return {
             "flutter_speed": self.flutter_speed,
+            "flutter_eas": self.flutter_eas,
+            "flutter_mach": self.flutter_mach,
+            "flutter_ktas": kt(self.flutter_speed),
+            "flutter_keas": kt(self.flutter_eas),
             "flutter_frequency": self.flutter_frequency,
             "flutter_mode": self.flutter_mode,
             "divergence_speed": self.divergence_speed,
+            "divergence_eas": self.divergence_eas,
+            "divergence_mach": self.divergence_mach,
+            "divergence_ktas": kt(self.divergence_speed),
+            "divergence_keas": kt(self.divergence_eas),
+            "altitude": self.altitude,
             "density": self.density,
+            "speed_of_sound": self.speed_of_sound,
+            "mach": self.mach,
+            "compressibility": self.compressibility,
+            "damping": self.damping,
             "n_states": self.n_states,
             "v_max": self.v_max,
             "searched_range": [0.0, self.searched_up_to],
@@ -153,30 +222,69 @@ class FlutterResult:
             **self.info,
         }
 
-    def summary(self, warnings: bool = True) -> str:
-        """Readable multi-line summary (with the warnings, unless ``warnings=False``)."""
+    def speed_text(self, v: float, units: str = "si") -> str:
+        """A speed as the field writes it: TAS with EAS and Mach, in m/s or knots."""
+        eas, mach = self.eas(v), self.mach_of(v)
+        if units == "knots":
+            text = f"{v / KNOT:.5g} KTAS (KEAS {eas / KNOT:.5g}"
+        else:
+            text = f"{v:.6g} m/s TAS (EAS {eas:.5g} m/s"
+        return text + (f", Mach {mach:.3f})" if mach is not None else ")")
+
+    def condition_text(self) -> str:
+        """The flight condition and the options of the analysis, one line."""
+        if self.altitude is not None:
+            text = f"altitude {self.altitude:.6g} m (ISA), density {self.density:.5g} kg/m^3"
+            text += f", speed of sound {self.speed_of_sound:.5g} m/s"
+        else:
+            text = f"density {self.density:g} kg/m^3"
+        text += f"; structural damping {self.damping}"
+        if self.compressibility:
+            text += f"; {self.compressibility} at Mach {self.mach:.4g}"
+        return text
+
+    def summary(self, warnings: bool = True, units: str = "si") -> str:
+        """Readable multi-line summary (with the warnings, unless ``warnings=False``).
+
+        Parameters
+        ----------
+        warnings : bool
+            Include the warnings.
+        units : {"si", "knots"}
+            Speeds in m/s or knots.
+        """
+        if units not in ("si", "knots"):
+            from ..errors import InputError
+
+            raise InputError(f"units = {units!r}: allowed values are 'si', 'knots'")
         top = self.searched_up_to
-        lines = [f"density {self.density:g} kg/m^3, speeds searched 0 .. {top:.4g} m/s"]
+        unit = "KTAS" if units == "knots" else "m/s"
+        scale = 1 / KNOT if units == "knots" else 1.0
+        lines = [
+            self.condition_text(),
+            f"speeds searched 0 .. {top * scale:.4g} {unit}" + (" TAS" if units == "si" else ""),
+        ]
         if not self.complete:
-            lines[0] += f" (of {self.v_max:.4g} m/s asked: the search stopped early)"
+            lines[1] += f" (of {self.v_max * scale:.4g} {unit} asked: the search stopped early)"
         if self.flutter is None:
-            lines.append(f"flutter: no flutter below {top:.4g} m/s")
+            tas = " TAS" if units == "si" else ""
+            lines.append(f"flutter: no flutter below {top * scale:.4g} {unit}{tas}")
         else:
             lines.append(
-                f"flutter: {self.flutter_speed:.6g} m/s at {self.flutter_frequency:.5g} Hz "
-                f"({self.flutter_mode})"
+                f"flutter: {self.speed_text(self.flutter_speed, units)} at "
+                f"{self.flutter_frequency:.5g} Hz ({self.flutter_mode})"
             )
         if self.divergence_speed is None:
             lines.append("divergence: none")
         else:
-            lines.append(f"divergence: {self.divergence_speed:.6g} m/s")
+            lines.append(f"divergence: {self.speed_text(self.divergence_speed, units)}")
         for c in self.crossings:
             lines.append(
-                f"  {c.kind:<10s} {c.speed:10.6g} m/s  {c.frequency:8.5g} Hz  "
+                f"  {c.kind:<10s} {c.speed * scale:10.6g} {unit}  {c.frequency:8.5g} Hz  "
                 f"{self.mode_labels[c.mode]}"
             )
         lines.append(
-            f"{self.n_states} states; tracked: "
+            f"{self.n_states} states; branches: "
             + ", ".join(
                 f"{lab} ({self.frequencies[0, j]:.4g} Hz)" for j, lab in enumerate(self.mode_labels)
             )

@@ -76,9 +76,17 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
     from ..stability.boundary import flutter_boundary
 
     model = scenario.model()
+    atm = scenario.atmosphere
     update, close = _progress_bar(scenario.v_max or 300.0, "flutter sweep", progress)
     try:
-        fr = flutter_boundary(model, scenario.density, v_max=scenario.v_max, progress=update)
+        if atm is not None:
+            from ..stability.matched import flutter_at
+
+            fr = flutter_at(
+                model, atm, compressibility=scenario.compressibility, v_max=scenario.v_max
+            )
+        else:
+            fr = flutter_boundary(model, scenario.density, v_max=scenario.v_max, progress=update)
     finally:
         close()
     summary = {
@@ -98,11 +106,23 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
     if scenario.pk:
         from ..stability.pk import pk_flutter
 
-        pk = pk_flutter(model, scenario.density, v_max=fr.v_max)
+        if atm is not None:
+            from ..stability.matched import flutter_at
+
+            pk = flutter_at(
+                model,
+                atm,
+                compressibility=scenario.compressibility,
+                solver=pk_flutter,
+                v_max=fr.v_max,
+            )
+        else:
+            pk = pk_flutter(model, scenario.density, v_max=fr.v_max)
         summary["pk_exact_theodorsen"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
         }
+
     title = f"{scenario.wing.name}: {model.n_elements} elements, {model.wagner.name}"
     return Run(scenario, summary, flutter=fr, title=title)
 
@@ -290,6 +310,7 @@ def study_from_scenario(scenario: Scenario):
     return TradeStudy(
         base_wing=scenario.wing,
         density=scenario.density,
+        damping=scenario.damping,
         elements=scenario.elements,
         wagner=scenario.wagner,
         controls=tuple(scenario.controls),

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..design.spec import ControllerSpec
+from ..system.damping import NO_DAMPING, StructuralDamping
 
 __all__ = ["Scenario", "Disturbance", "quick", "SCENARIO_KINDS"]
 
@@ -50,6 +51,9 @@ class Scenario:
     description: str = ""
     wing_source: str = ""
     density: float = 1.225
+    altitude: float | None = None
+    compressibility: str | None = None
+    damping: StructuralDamping = NO_DAMPING
     speed: float | None = None
     speed_factor: float | None = None
     elements: int = 10
@@ -81,7 +85,14 @@ class Scenario:
         """The aeroelastic model of the scenario's wing and options."""
         from ..system.aeroelastic import AeroelasticModel
 
-        return AeroelasticModel(self.wing, self.elements, self.wagner)
+        return AeroelasticModel(self.wing, self.elements, self.wagner, damping=self.damping)
+
+    @property
+    def atmosphere(self):
+        """The standard atmosphere at the scenario's altitude, or None (density given)."""
+        from ..aero.atmosphere import isa
+
+        return None if self.altitude is None else isa(self.altitude)
 
     def loop(self, model=None):
         """The :class:`~aeroservo.design.loop.ControlLoop` of a simulate scenario."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -12,7 +12,8 @@ from ..errors import InputError, check_int, check_number
 from ..structure.mesh import Mesh, build_mesh
 from ..structure.wing import Wing
 from .assembly import assemble, element_properties
-from .first_order import FirstOrderSystem, first_order
+from .damping import NO_DAMPING, StructuralDamping, damping_matrix
+from .first_order import FirstOrderSystem, check_mach, first_order
 from .matrices import AeroMatrices
 
 __all__ = ["AeroelasticModel", "NaturalModes"]
@@ -49,6 +50,8 @@ class AeroelasticModel:
     wagner : str, mapping or IndicialSet
         Wagner approximation: ``"rt_jones"`` (default), ``"wp_jones"``, ``"one_term"``,
         ``"fit2"``, ``"fit3"``, ``"fit4"``, or ``{"A": [...], "b": [...]}``.
+    damping : StructuralDamping, optional
+        Structural damping (:mod:`aeroservo.system.damping`); default none.
 
     Notes
     -----
@@ -57,21 +60,30 @@ class AeroelasticModel:
     at speed V is ``A(V) = A0 + V A1 + V^2 A2``.
     """
 
-    def __init__(self, wing: Wing, n_elements: int = 10, wagner: object = "rt_jones"):
+    def __init__(
+        self,
+        wing: Wing,
+        n_elements: int = 10,
+        wagner: object = "rt_jones",
+        damping: StructuralDamping | None = None,
+    ):
         if not isinstance(wing, Wing):
             raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
         self.wing = wing
         self.n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
         self.wagner: IndicialSet = wagner_set(wagner)
+        self.damping = NO_DAMPING if damping is None else damping
         self.mesh: Mesh = build_mesh(wing, self.n_elements)
-        self.matrices: AeroMatrices = assemble(wing, self.mesh)
+        am = assemble(wing, self.mesh)
+        self.matrices: AeroMatrices = replace(am, Cs=damping_matrix(self.damping, am.Ms, am.Ks))
         self.properties = element_properties(wing, self.mesh)
-        self._systems: dict[float, FirstOrderSystem] = {}
+        self._systems: dict[tuple[float, float], FirstOrderSystem] = {}
 
     def __repr__(self) -> str:
+        damping = "" if not self.damping.active else f", damping={self.damping.describe()!r}"
         return (
             f"AeroelasticModel({self.wing.name!r}, n_elements={self.n_elements}, "
-            f"wagner={self.wagner.name!r}, n_states={self.n_states})"
+            f"wagner={self.wagner.name!r}{damping}, n_states={self.n_states})"
         )
 
     @property
@@ -89,17 +101,22 @@ class AeroelasticModel:
         """Span-averaged semichord [m]."""
         return float(np.sum(self.properties["b"] * self.mesh.lengths) / self.wing.span)
 
-    def system(self, density: float) -> FirstOrderSystem:
-        """First-order system at air density ``density`` [kg/m^3] (cached)."""
+    def system(self, density: float, mach: float = 0.0) -> FirstOrderSystem:
+        """First-order system at air density ``density`` [kg/m^3] and the Mach number ``mach``
+        of the compressibility correction (0: incompressible), cached."""
         rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-        if rho not in self._systems:
-            self._systems[rho] = first_order(self.matrices, self.wagner, rho, self.semichord)
-        return self._systems[rho]
+        mach = check_mach(mach)
+        key = (rho, mach)
+        if key not in self._systems:
+            self._systems[key] = first_order(
+                self.matrices, self.wagner, rho, self.semichord, mach=mach
+            )
+        return self._systems[key]
 
-    def state_matrix(self, speed: float, density: float) -> np.ndarray:
+    def state_matrix(self, speed: float, density: float, mach: float = 0.0) -> np.ndarray:
         """Dense state matrix A(V) [1/s] at ``speed`` [m/s] and ``density`` [kg/m^3]."""
         v = check_number("speed", speed, unit="m/s", lo=0.0)
-        return self.system(density).state_matrix(v)
+        return self.system(density, mach).state_matrix(v)
 
     def natural_modes(self, n_modes: int = 6) -> NaturalModes:
         """In-vacuo natural modes (structural mass and stiffness only).

@@ -4,13 +4,21 @@ State ``x = [q, qdot, z]``: structural unknowns q, their rates, and the Wagner l
 (one per term and node, node-major). With ``M = Ms + rho Mnc``:
 
 * ``qdot = v``
-* ``M vdot = -(Ks + rho V^2 Ka) q - rho V Ca v + rho V^2 Dz z``
+* ``M vdot = -(Ks + rho V^2 Ka) q - (Cs + rho V Ca) v + rho V^2 Dz z``
 * ``Mz zdot = V Ez q + Fz v - V Lam z``
 
-where ``Ca = Cnc - (1 - sum A) Pd``, ``Ka = Knc - (1 - sum A) Pq``, ``Dz = W1 (x) (A_i b_i)``,
-``Mz = Mz1 (x) I``, ``Lam = Lz1 (x) diag(b_i)``, ``Ez = E1 (x) 1``, ``Fz = F1 (x) 1``. The lag
-equations are first order, so the mass matrix is never inverted as a whole: ``E`` is
-block-diagonal ``(I, M, Mz)`` and both blocks are positive definite.
+where ``Ca = Cnc - c (1 - sum A) Pd``, ``Ka = Knc - c (1 - sum A) Pq``,
+``Dz = W1 (x) (c A_i b_i beta^2)``, ``Mz = Mz1 (x) I``, ``Lam = Lz1 (x) diag(b_i beta^2)``,
+``Ez = E1 (x) 1``, ``Fz = F1 (x) 1``, and ``Cs`` the structural damping. The lag equations are
+first order, so the mass matrix is never inverted as a whole: ``E`` is block-diagonal
+``(I, M, Mz)`` and both blocks are positive definite.
+
+**Compressibility (optional).** At a Mach number M the Prandtl-Glauert correction scales the
+circulatory loads by ``c = 1 / beta``, ``beta = sqrt(1 - M^2)`` (lift slope ``2 pi / beta``)
+and the lag rates by ``beta^2`` (the indicial functions run ``beta^2`` times slower in reduced
+time): ``C(k) -> C(k / beta^2) / beta``. The apparent-mass terms are left incompressible. The
+Mach number is a parameter of the system, like the density; a matched point (Mach = V / a at
+the flutter speed) is found by iteration (:mod:`aeroservo.stability.matched`).
 """
 
 from __future__ import annotations
@@ -22,9 +30,10 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..aero.indicial import IndicialSet
+from ..errors import InputError, check_number
 from .matrices import AeroMatrices
 
-__all__ = ["FirstOrderSystem", "first_order"]
+__all__ = ["FirstOrderSystem", "first_order", "check_mach", "MACH_LIMIT", "MACH_APPROXIMATE"]
 
 
 @dataclass
@@ -49,6 +58,12 @@ class FirstOrderSystem:
         Lag states of a mode at V = 0: z = lag_at_rest @ q.
     semichord : float
         Reference semichord [m] (mean over the span), used for default speed ranges.
+    mach : float
+        Mach number of the compressibility correction (0: incompressible).
+    Cs : sparse (n_q, n_q) or None
+        Structural damping (None: undamped).
+
+
     """
 
     E: sp.csr_matrix
@@ -63,6 +78,8 @@ class FirstOrderSystem:
     K_static: np.ndarray
     lag_at_rest: sp.csr_matrix
     semichord: float = 1.0
+    mach: float = 0.0
+    Cs: sp.csr_matrix | None = None
     _dense: tuple | None = field(default=None, repr=False)
 
     @property
@@ -93,21 +110,48 @@ class FirstOrderSystem:
     def modes_at_rest(self, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
         """The ``n_modes`` lowest oscillatory eigenpairs at V = 0 (apparent mass included).
 
+        With structural damping each undamped pair ``i omega`` is corrected to the damped root
+        of ``(lam^2 M + lam Cs + Ks) q = 0`` by nonlinear Rayleigh-quotient iteration.
+
         Returns
         -------
         lam : ndarray (n_modes,) complex
-            Eigenvalues i omega [1/s].
+            Eigenvalues [1/s] (``i omega`` without structural damping).
         X : ndarray (n_states, n_modes) complex
-            State eigenvectors ``[q, i omega q, z]``, unit norm.
+            State eigenvectors ``[q, lam q, z]``, unit norm.
         """
         n_modes = min(int(n_modes), self.n_q)
-        w2, phi = sla.eigh(self.Ks.toarray(), self.M.toarray(), subset_by_index=[0, n_modes - 1])
+        K, M = self.Ks.toarray(), self.M.toarray()
+        w2, phi = sla.eigh(K, M, subset_by_index=[0, n_modes - 1])
         omega = np.sqrt(np.clip(w2, 0.0, None))
         lam = 1j * omega
+        phi = phi.astype(complex)
+        if self.Cs is not None:
+            C = self.Cs.toarray()
+            for j in range(n_modes):
+                lam[j], phi[:, j] = _damped_pair(K, C, M, lam[j], phi[:, j])
         z = self.lag_at_rest @ phi
         X = np.vstack([phi, phi * lam[None, :], z]).astype(complex)
         X /= np.linalg.norm(X, axis=0)
         return lam, X
+
+
+def _damped_pair(K, C, M, lam: complex, q: np.ndarray) -> tuple[complex, np.ndarray]:
+    """Root of ``(lam^2 M + lam C + K) q = 0`` near ``(lam, q)`` (nonlinear Rayleigh quotient
+    iteration: the scalar quadratic ``q^H T(lam) q = 0`` for lam, then ``T(lam)^-1 T'(lam) q``)."""
+    for _ in range(20):
+        m, c, k = (np.vdot(q, A @ q) for A in (M, C, K))
+        roots = np.roots([m, c, k])
+        new = complex(roots[np.argmin(np.abs(roots - lam))])
+        if new.imag < 0:
+            new = new.conjugate()
+        done = abs(new - lam) <= 1e-13 * abs(new)
+        lam = new
+        if done:
+            break
+        y = np.linalg.solve(lam * lam * M + lam * C + K, (2 * lam * M + C) @ q)
+        q = y / np.linalg.norm(y)
+    return lam, q
 
 
 def _block_inverse(E: sp.csr_matrix, n_q: int) -> np.ndarray:
@@ -122,8 +166,37 @@ def _block_inverse(E: sp.csr_matrix, n_q: int) -> np.ndarray:
     return out
 
 
+MACH_LIMIT = 0.9
+"""The Prandtl-Glauert correction is refused at and above this Mach number (transonic flow)."""
+
+MACH_APPROXIMATE = 0.7
+"""Above this Mach number results with the correction are flagged as approximate."""
+
+
+def check_mach(mach: object, field: str = "mach") -> float:
+    """Validate the Mach number of the compressibility correction, ``0 <= M < 0.9``."""
+    m = check_number(field, mach, lo=0.0)
+    if m >= MACH_LIMIT:
+        raise InputError(
+            f"{field} = {m:g}: the Prandtl-Glauert correction is refused at Mach >= "
+            f"{MACH_LIMIT:g} (transonic flow: shocks, not a linear correction)"
+        )
+    return m
+
+
+def compressibility_factors(mach: float) -> tuple[float, float]:
+    """``(1 / beta, beta^2)`` of the Prandtl-Glauert correction at a Mach number < 1."""
+    beta2 = 1.0 - float(mach) ** 2
+    return 1.0 / np.sqrt(beta2), beta2
+
+
 def first_order(
-    am: AeroMatrices, wagner: IndicialSet, density: float, semichord: float = 1.0
+    am: AeroMatrices,
+    wagner: IndicialSet,
+    density: float,
+    semichord: float = 1.0,
+    *,
+    mach: float = 0.0,
 ) -> FirstOrderSystem:
     """Assemble the first-order system of ``am`` with a Wagner set at air density ``density``.
 
@@ -136,6 +209,8 @@ def first_order(
         Air density [kg/m^3].
     semichord : float
         Reference semichord [m] stored on the result.
+    mach : float
+        Mach number of the Prandtl-Glauert correction (0: incompressible), ``0 <= M < 1``.
 
     Returns
     -------
@@ -147,7 +222,9 @@ def first_order(
     bt = np.asarray(wagner.b)
     T = A.size
     one_col = sp.csr_matrix(np.ones((T, 1)))
-    scale = 1.0 - A.sum()
+    c, beta2 = compressibility_factors(mach)
+    scale = c * (1.0 - A.sum())
+    bt = bt * beta2
 
     M = (am.Ms + rho * am.Mnc).tocsr()
     Ca = am.Cnc - scale * am.Pd
@@ -156,12 +233,13 @@ def first_order(
     Lam = sp.kron(am.Lz1, sp.diags(bt)).tocsr()
     Ez = sp.kron(am.E1, one_col).tocsr()
     Fz = sp.kron(am.F1, one_col).tocsr()
-    Dz = sp.kron(am.W1, sp.csr_matrix((A * bt)[None, :])).tocsr()
+    Dz = sp.kron(am.W1, sp.csr_matrix((c * A * bt)[None, :])).tocsr()
     n_z = n_n * T
 
     I = sp.eye(n_q)
     Zqq = None
-    A0 = sp.bmat([[Zqq, I, None], [-am.Ks, None, None], [None, Fz, sp.csr_matrix((n_z, n_z))]])
+    Cs = -am.Cs if am.Cs is not None else None
+    A0 = sp.bmat([[Zqq, I, None], [-am.Ks, Cs, None], [None, Fz, sp.csr_matrix((n_z, n_z))]])
     A1 = sp.bmat(
         [[sp.csr_matrix((n_q, n_q)), None, None], [None, -rho * Ca, None], [Ez, None, -Lam]]
     )
@@ -197,4 +275,6 @@ def first_order(
         K_static=K_static,
         lag_at_rest=lag_at_rest,
         semichord=float(semichord),
+        mach=float(mach),
+        Cs=am.Cs,
     )

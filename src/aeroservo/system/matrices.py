@@ -58,6 +58,8 @@ class AeroMatrices:
     stiffness_parts : dict of sparse
         ``Ks`` split by origin (e.g. ``"bending"``, ``"torsion"``, ``"flap (aileron)"``), used to
         name modes by their strain energy.
+    Cs : sparse (n_q, n_q) or None
+        Structural damping (:mod:`aeroservo.system.damping`); None: undamped.
     root : AeroMatrices or None
         The same matrices restricted to the rows of the clamped root unknowns ``(w, theta,
         phi)`` (3 rows each): the root reactions are ``Ks q + Ms qdd - f_aero`` on those rows.
@@ -79,6 +81,7 @@ class AeroMatrices:
     dof_labels: tuple[str, ...]
     lag_labels: tuple[str, ...]
     stiffness_parts: dict = field(default_factory=dict)
+    Cs: sp.csr_matrix | None = None
     root: AeroMatrices | None = None
     basis: np.ndarray | None = None
 
@@ -141,7 +144,9 @@ class AeroMatrices:
                     StripGroup(g.b, cols(g.Pq), cols(g.Pd), g.Gw) for g in rt.circ_groups
                 ),
                 stiffness_parts={},
+                Cs=None,
             )
+
         full = phi if self.basis is None else self.basis @ phi
         return replace(
             self,
@@ -156,6 +161,7 @@ class AeroMatrices:
             W1=sp.csr_matrix(phi.T @ self.W1),
             dof_labels=labels or tuple(f"eta_{j + 1}" for j in range(r)),
             stiffness_parts={k: both(v) for k, v in self.stiffness_parts.items()},
+            Cs=None if self.Cs is None else both(self.Cs),
             root=root,
             basis=full,
         )

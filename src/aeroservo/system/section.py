@@ -17,7 +17,8 @@ import scipy.sparse as sp
 from ..aero.indicial import wagner_set
 from ..aero.theodorsen import section_aero
 from ..errors import InputError, check_number
-from .first_order import FirstOrderSystem, first_order
+from .damping import NO_DAMPING, StructuralDamping, damping_matrix
+from .first_order import FirstOrderSystem, check_mach, first_order
 from .matrices import AeroMatrices, StripGroup
 
 __all__ = ["TypicalSection"]
@@ -47,6 +48,8 @@ class TypicalSection:
         S_beta [kg m/m], I_beta about the hinge [kg m], hinge spring [N m/rad per m].
     wagner : str or mapping
         Wagner approximation for the time-domain model (default ``"rt_jones"``).
+    damping : StructuralDamping, optional
+        Structural damping (:mod:`aeroservo.system.damping`); default none.
     """
 
     semichord: float
@@ -61,6 +64,7 @@ class TypicalSection:
     flap_inertia: float = 0.0
     k_flap: float = 0.0
     wagner: object = "rt_jones"
+    damping: StructuralDamping | None = None
 
     def __post_init__(self) -> None:
         check_number("section.semichord", self.semichord, unit="m", lo=0.0, lo_open=True)
@@ -79,6 +83,8 @@ class TypicalSection:
         if np.linalg.eigvalsh(self.mass_matrix()).min() <= 0:
             raise InputError("section: the mass matrix is not positive definite")
         wagner_set(self.wagner)
+        if self.damping is not None and not isinstance(self.damping, StructuralDamping):
+            raise InputError(f"section.damping = {self.damping!r}: expected a StructuralDamping")
 
     @classmethod
     def from_nondimensional(
@@ -97,6 +103,7 @@ class TypicalSection:
         r_beta2: float = 0.0,
         omega_beta: float = 0.0,
         wagner: object = "rt_jones",
+        damping: StructuralDamping | None = None,
     ) -> TypicalSection:
         """Section from the classical parameters (Theodorsen, Bisplinghoff, Hodges & Pierce).
 
@@ -120,6 +127,7 @@ class TypicalSection:
             flap_inertia=i_b,
             k_flap=i_b * omega_beta**2,
             wagner=wagner,
+            damping=damping,
         )
 
     @property
@@ -147,6 +155,7 @@ class TypicalSection:
         c = 1.0 if self.hinge is None else self.hinge
         aero = section_aero(self.semichord, self.a, c)
         ks = np.diag([self.k_plunge, self.k_pitch, self.k_flap])[:n, :n]
+        cs = damping_matrix(self.damping or NO_DAMPING, self.mass_matrix(), ks)
 
         def csr(x):
             return sp.csr_matrix(np.atleast_2d(x))
@@ -169,12 +178,16 @@ class TypicalSection:
             W1=csr(aero.w[:n, None]),
             dof_labels=("w", "phi", "delta")[:n],
             lag_labels=("0",),
+            Cs=cs,
         )
 
-    def system(self, density: float) -> FirstOrderSystem:
-        """First-order system at air density ``density`` [kg/m^3]."""
+    def system(self, density: float, mach: float = 0.0) -> FirstOrderSystem:
+        """First-order system at air density ``density`` [kg/m^3] and compressibility Mach
+        number ``mach``."""
         rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-        return first_order(self.matrices, wagner_set(self.wagner), rho, self.semichord)
+        return first_order(
+            self.matrices, wagner_set(self.wagner), rho, self.semichord, mach=check_mach(mach)
+        )
 
     def label_modes(self, shapes: np.ndarray) -> list[str]:
         """Name modes by their dominant unknown (plunge, pitch, flap)."""

@@ -75,12 +75,12 @@ def _stage_model(study: TradeStudy, wing: Wing) -> dict:
     from ...stability.boundary import flutter_boundary
     from ...system.aeroelastic import AeroelasticModel
 
-    key = (repr(wing), study.density, study.elements, study.wagner)
+    key = (repr(wing), study.density, study.elements, study.wagner, study.damping)
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
         return hit
-    model = AeroelasticModel(wing, study.elements, study.wagner)
+    model = AeroelasticModel(wing, study.elements, study.wagner, damping=study.damping)
     entry = {"model": model, "flutter": flutter_boundary(model, study.density), "loops": {}}
     _CACHE[key] = entry
     while len(_CACHE) > _CACHE_SIZE:

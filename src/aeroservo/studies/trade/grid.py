@@ -46,6 +46,8 @@ def study_settings(study: TradeStudy) -> dict:
         "wagner": study.wagner,
         "closed_loop": study.closed_loop,
     }
+    if study.damping.active:  # only then: undamped studies keep their case ids
+        s["damping"] = study.damping.to_dict()
     if study.closed_loop:
         spec = _jsonable(study.controller)
         for k in ("name", "source"):  # labels only: they do not change the results

@@ -48,6 +48,7 @@ import numpy as np
 from ...design.spec import ControllerSpec
 from ...errors import InputError, check_int, check_number
 from ...structure.wing import Wing
+from ...system.damping import NO_DAMPING, StructuralDamping
 
 __all__ = ["PARAMETERS", "METRICS", "FORMAT", "TradeStudy"]
 
@@ -131,6 +132,8 @@ class TradeStudy:
         Wing with exactly one control surface (the aileron) that the parameters vary.
     density : float
         Air density [kg/m^3].
+    damping : StructuralDamping
+        Structural damping of every variant (default none).
     elements : int
         Beam elements along the span.
     wagner : str
@@ -176,6 +179,7 @@ class TradeStudy:
 
     base_wing: Wing
     density: float = 1.225
+    damping: StructuralDamping = NO_DAMPING
     elements: int = 10
     wagner: str = "rt_jones"
     controls: tuple = ("aileron_hinge_moment",)
@@ -249,6 +253,8 @@ class TradeStudy:
             )
         if not isinstance(self.closed_loop, bool):
             raise InputError(f"closed_loop = {self.closed_loop!r}: expected true or false")
+        if not isinstance(self.damping, StructuralDamping):
+            raise InputError(f"damping = {self.damping!r}: expected a StructuralDamping")
         put(self, "parameters", self._check_parameters())
         if self.closed_loop:
             self._check_controller()

@@ -1,0 +1,86 @@
+"""The ``aeroservo`` command.
+
+Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure.
+Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
+need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``) and
+:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``plot``, ``examples``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from .._threads import blas_limited
+from ..errors import InputError
+from . import analysis, scenarios
+
+__all__ = ["main"]
+
+
+class _UsageError(InputError):
+    """A command-line usage error (one line, exit 2)."""
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse that reports a usage error in one line (with where to find help)."""
+
+    def error(self, message: str):
+        raise _UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def _parser() -> argparse.ArgumentParser:
+    from .._version import __version__
+
+    p = _OneLineParser(
+        prog="aeroservo",
+        description="Aero-servo-elastic analysis of wings with control surfaces (SI units).",
+    )
+    p.add_argument("--version", action="version", version=f"aeroservo {__version__}")
+    p.add_argument("--debug", action="store_true", help="show the traceback of an unexpected error")
+    sub = p.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=_OneLineParser
+    )
+    analysis.add_parsers(sub)
+    scenarios.add_parsers(sub)
+    return p
+
+
+@blas_limited
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as exc:
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    handlers = {**analysis.HANDLERS, **scenarios.HANDLERS}
+    try:
+        return handlers[args.command](args)
+
+    except InputError as exc:
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # unwritable output folder, unreadable file
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ArithmeticError, __import__("numpy").linalg.LinAlgError) as exc:
+        if args.debug:
+            raise
+        print(f"aeroservo: numerical failure: {exc}", file=sys.stderr)
+        return 1
+    except Exception as exc:  # a bug: one line, an invitation to report it
+        if args.debug:
+            raise
+        print(
+            f"aeroservo: internal error: {type(exc).__name__}: {exc} (please report it; "
+            "'aeroservo --debug ...' shows the traceback)",
+            file=sys.stderr,
+        )
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

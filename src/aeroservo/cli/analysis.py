@@ -1,0 +1,277 @@
+"""The analysis commands: ``flutter``, ``envelope`` and ``modes``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from .options import add_flight_options, add_model_options, positive_float, positive_int, setup
+
+__all__ = ["add_parsers", "HANDLERS"]
+
+
+def add_parsers(sub) -> None:
+    """The analysis commands' parsers."""
+    f = sub.add_parser(
+        "flutter",
+        help="flutter and divergence boundaries of a wing",
+        description="Flutter and divergence boundaries of a built-in wing, a wing file or the "
+        "wing of a scenario file, at a density or an altitude (docs/stability.md).",
+    )
+    f.add_argument(
+        "wing", help="built-in wing (goland, goland_aileron), a wing .toml or a scenario .toml"
+    )
+    f.add_argument("--json", action="store_true", help="print one JSON object")
+    add_flight_options(f)
+    add_model_options(f)
+    f.add_argument("--v-max", type=positive_float, help="upper end of the speed search [m/s]")
+    f.add_argument(
+        "--modes",
+        type=positive_int,
+        help="fewest modes in the modal model (default 6; the mode rule and the certificate "
+        "add what the wing needs, docs/stability.md)",
+    )
+    f.add_argument(
+        "--pk", action="store_true", help="also solve by p-k with the exact Theodorsen function"
+    )
+    f.add_argument("--plot", metavar="FILE", help="write V-g and V-f diagrams (png, pdf, svg)")
+    f.add_argument(
+        "--g-required",
+        type=positive_float,
+        metavar="G",
+        help="required damping margin drawn on the V-g plot (e.g. 0.03)",
+    )
+
+    e = sub.add_parser(
+        "envelope",
+        help="flutter clearance over altitude against a V_D / M_D envelope",
+        description="Matched flutter and divergence speeds (TAS, EAS, Mach) at each altitude of "
+        "the standard atmosphere, checked against the design envelope with the margin.",
+    )
+    e.add_argument("wing", help="built-in wing, a wing .toml or a scenario .toml")
+    alt = e.add_mutually_exclusive_group(required=True)
+    alt.add_argument("--altitudes", metavar="START:STOP:STEP", help="altitudes [m], or a,b,c")
+    alt.add_argument("--altitudes-ft", metavar="START:STOP:STEP", help="altitudes [ft]")
+    e.add_argument("--vd", type=positive_float, help="design dive speed V_D, EAS (in --units)")
+    e.add_argument("--md", type=positive_float, help="design dive Mach number M_D")
+    e.add_argument(
+        "--margin", type=positive_float, default=1.15, help="margin on V_D/M_D (default 1.15)"
+    )
+    e.add_argument(
+        "--compressibility",
+        choices=("none", "prandtl-glauert"),
+        help="Prandtl-Glauert correction, Mach matched at each altitude",
+    )
+    e.add_argument("--units", choices=("si", "knots"), default="si")
+    add_model_options(e)
+    e.add_argument("--json", action="store_true", help="print one JSON object")
+    e.add_argument("--csv", metavar="FILE", help="write the table (one row per altitude)")
+    e.add_argument("--plot", metavar="FILE", help="write the envelope plot (png, pdf, svg)")
+    e.add_argument("--x", choices=("eas", "mach"), default="eas", help="plot axis")
+    e.add_argument(
+        "--progress",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="progress bar on stderr (default: when stderr is a terminal)",
+    )
+
+    m = sub.add_parser("modes", help="natural frequencies of a wing (in vacuo)")
+    m.add_argument("wing")
+    m.add_argument("--elements", type=positive_int)
+    m.add_argument("-n", type=positive_int, default=6, help="number of modes (default 6)")
+    m.add_argument("--json", action="store_true")
+
+
+def _check_figure(path: str | None) -> None:
+    """Refuse an unknown figure format before computing anything."""
+    if path is None:
+        return
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    fmt = Path(path).suffix.lstrip(".").lower()
+    if fmt not in ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff", "webp"):
+        raise InputError(f"--plot = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
+
+
+def _cmd_flutter(args: argparse.Namespace) -> int:
+    from ..stability.boundary import flutter_boundary
+
+    _check_figure(args.plot)
+    s = setup(args)
+    model, wing = s.model, s.wing
+    v_max = args.v_max if args.v_max is not None else s.opts.v_max
+    n_modes = args.modes if args.modes is not None else s.opts.n_modes
+    kw = {"v_max": v_max, "n_modes": n_modes}
+    if s.atmosphere is not None:
+        from ..stability.matched import flutter_at
+
+        result = flutter_at(model, s.atmosphere, compressibility=s.compressibility, **kw)
+    else:
+        result = flutter_boundary(model, s.density, **kw)
+    out = {
+        "wing": wing.name,
+        "flutter_speed": result.flutter_speed,
+        "flutter_frequency": result.flutter_frequency,
+        "divergence_speed": result.divergence_speed,
+        "n_states": result.n_states,
+        "density": s.density,
+        "n_elements": model.n_elements,
+        "wagner": model.wagner.name,
+        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3", "altitude": "m"},
+    }
+    out.update({k: v for k, v in result.to_dict().items() if k not in out})
+    pk = None
+    if args.pk:
+        from ..stability.pk import pk_flutter
+
+        kw["v_max"] = result.v_max
+        if s.atmosphere is not None:
+            from ..stability.matched import flutter_at
+
+            pk = flutter_at(
+                model, s.atmosphere, compressibility=s.compressibility, solver=pk_flutter, **kw
+            )
+        else:
+            pk = pk_flutter(model, s.density, **kw)
+        out["pk_exact_theodorsen"] = {
+            "flutter_speed": pk.flutter_speed,
+            "flutter_frequency": pk.flutter_frequency,
+            "flutter_eas": pk.flutter_eas,
+            "flutter_mach": pk.flutter_mach,
+            "divergence_speed": pk.divergence_speed,
+        }
+    if args.plot:
+        from ..atomic import save_figure
+        from ..plots import plot_vg
+
+        title = f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
+        fig = plot_vg(result, title=title, g_required=args.g_required, units=args.units)
+        save_figure(fig, args.plot, dpi=150)
+        out["plot"] = args.plot
+    for w in result.warnings:
+        print(f"aeroservo: warning: {w}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
+    print(result.summary(warnings=False, units=args.units))
+    if pk is not None:
+        if pk.flutter_speed is None:
+            print(f"p-k (exact Theodorsen): no flutter below {pk.searched_up_to:.4g} m/s")
+        else:
+            text = pk.speed_text(pk.flutter_speed, args.units)
+            print(f"p-k (exact Theodorsen): flutter {text} at {pk.flutter_frequency:.5g} Hz")
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def _cmd_envelope(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..aero.atmosphere import KNOT
+    from ..atomic import atomic_write_set, figure_writer
+    from ..files.results import json_text
+    from ..studies.envelope import flutter_envelope, parse_altitudes
+
+    _check_figure(args.plot)
+    alts = parse_altitudes(args.altitudes_ft, "ft") if args.altitudes_ft else None
+    alts = alts or parse_altitudes(args.altitudes)
+    s = setup(args, altitudes=True)
+    vd = None if args.vd is None else args.vd * (KNOT if args.units == "knots" else 1.0)
+    progress = sys.stderr.isatty() if args.progress is None else args.progress
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=len(alts), desc="envelope", unit="altitude", leave=False)
+    try:
+        env = flutter_envelope(
+            s.model,
+            alts,
+            compressibility=s.compressibility,
+            vd=vd,
+            md=args.md,
+            margin=args.margin,
+            progress=(lambda i: bar.update(1)) if bar is not None else None,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    items = []
+    if args.csv:
+        items.append((Path(args.csv), lambda p: p.write_text(env.csv_text(args.units))))
+    if args.plot:
+        fig = env.plot(units=args.units, x=args.x)
+        items.append((Path(args.plot), figure_writer(fig, args.plot, dpi=150)))
+    atomic_write_set(items)
+    for p in env.points:
+        for w in p.warnings:
+            print(f"aeroservo: warning: {p.altitude:g} m: {w}", file=sys.stderr)
+    if args.json:
+        print(json_text(env.to_dict()))
+        return 0
+    print(_envelope_text(env, args.units))
+    for kind, path in (("table", args.csv), ("plot", args.plot)):
+        if path:
+            print(f"{kind} written to {path}")
+    return 0
+
+
+def _envelope_text(env, units: str) -> str:
+    from ..aero.atmosphere import KNOT
+
+    k = 1 / KNOT if units == "knots" else 1.0
+    u = "kt" if units == "knots" else "m/s"
+
+    def f(v, fmt="8.4g"):
+        return f"{'-':>8s}" if v is None else f"{v:{fmt}}"
+
+    comp = env.compressibility or "incompressible"
+    lines = [f"{env.wing}: flutter envelope ({comp}; structural damping {env.damping})"]
+    head = f"  {'alt [m]':>8s} {'VF TAS':>8s} {'VF EAS':>8s} {'MF':>8s} {'VD EAS':>8s}"
+    if env.envelope:
+        head += f" {'req EAS':>8s}  margin"
+    lines += [head + f"   (speeds in {u})"]
+    for p in env.points:
+        row = f"  {p.altitude:8.0f} {f(p.flutter_speed and p.flutter_speed * k)}"
+        row += f" {f(p.flutter_eas and p.flutter_eas * k)} {f(p.flutter_mach, '8.3f')}"
+        row += f" {f(p.divergence_eas and p.divergence_eas * k)}"
+        if env.envelope:
+            row += f" {f(p.required_eas * k)}  {'ok' if p.margin_ok else 'FAIL'}"
+        lines.append(row)
+    if env.envelope:
+        lines.append(f"  clearance with margin {env.margin:g}: {'ok' if env.margin_ok else 'FAIL'}")
+    return "\n".join(lines)
+
+
+def _cmd_modes(args: argparse.Namespace) -> int:
+    from ..files.wing_file import resolve_wing
+    from ..system.aeroelastic import AeroelasticModel
+
+    wing, opts = resolve_wing(args.wing)
+    model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
+    modes = model.natural_modes(min(args.n, model.n_dofs))
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "wing": wing.name,
+                    "frequencies": modes.frequencies.tolist(),
+                    "labels": modes.labels,
+                    "units": {"frequency": "Hz"},
+                },
+                indent=2,
+            )
+        )
+    else:
+        print(f"{wing.name}: {model.n_elements} elements, in-vacuo natural modes")
+        for fr, lab in zip(modes.frequencies, modes.labels, strict=True):
+            print(f"  {fr:10.4f} Hz  {lab}")
+    return 0
+
+
+HANDLERS = {"flutter": _cmd_flutter, "envelope": _cmd_envelope, "modes": _cmd_modes}

@@ -1,0 +1,176 @@
+"""Options shared by the analysis commands: numbers, the model, the flight condition, damping."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+
+from ..errors import InputError
+
+__all__ = [
+    "positive_float",
+    "positive_int",
+    "add_model_options",
+    "add_flight_options",
+    "Setup",
+    "setup",
+]
+
+
+def positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not v > 0 or v != v or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number > 0")
+    return v
+
+
+def positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be >= 1")
+    return v
+
+
+def _number(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if v != v or abs(v) == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number")
+    return v
+
+
+def _numbers(text: str) -> list[float]:
+    try:
+        return [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected numbers separated by commas"
+        ) from None
+
+
+def add_model_options(p: argparse.ArgumentParser) -> None:
+    """``--elements``, ``--wagner`` and the structural damping options."""
+    p.add_argument(
+        "--elements", type=positive_int, help="number of beam elements (default: file, else 10)"
+    )
+    p.add_argument("--wagner", help="Wagner set: rt_jones, wp_jones, one_term, fit2, fit3, fit4")
+    d = p.add_mutually_exclusive_group()
+    d.add_argument(
+        "--damping-ratio",
+        type=_numbers,
+        metavar="Z[,Z...]",
+        help="modal viscous damping ratio (one for all in-vacuo modes, or one per mode, the "
+        "last repeated)",
+    )
+    d.add_argument(
+        "--structural-g",
+        type=_number,
+        metavar="G",
+        help="structural damping g (equivalent viscous zeta = g/2 at every in-vacuo mode)",
+    )
+    d.add_argument(
+        "--rayleigh",
+        type=_numbers,
+        metavar="ALPHA,BETA",
+        help="Rayleigh damping alpha M + beta K (alpha [1/s], beta [s])",
+    )
+
+
+def add_flight_options(p: argparse.ArgumentParser) -> None:
+    """The flight condition: density or altitude, compressibility, units."""
+    f = p.add_mutually_exclusive_group()
+    f.add_argument(
+        "--density", type=positive_float, help="air density [kg/m^3] (default: file, else 1.225)"
+    )
+    f.add_argument(
+        "--altitude", type=_number, metavar="M", help="geopotential altitude [m] (ISA 1976)"
+    )
+    f.add_argument("--altitude-ft", type=_number, metavar="FT", help="altitude [ft] (ISA 1976)")
+    p.add_argument(
+        "--compressibility",
+        choices=("none", "prandtl-glauert"),
+        help="Prandtl-Glauert correction, Mach matched at the altitude (needs an altitude)",
+    )
+    p.add_argument(
+        "--units", choices=("si", "knots"), default="si", help="speeds in the text and plots"
+    )
+
+
+@dataclass
+class Setup:
+    """What the options resolve to."""
+
+    wing: object
+    model: object
+    atmosphere: object  # Atmosphere or None
+    density: float
+    compressibility: str | None
+    opts: object
+
+
+def _damping(args, default):
+    from ..system.damping import StructuralDamping
+
+    if getattr(args, "damping_ratio", None) is not None:
+        return StructuralDamping.modal(args.damping_ratio)
+    if getattr(args, "structural_g", None) is not None:
+        return StructuralDamping.structural(args.structural_g)
+    if getattr(args, "rayleigh", None) is not None:
+        if len(args.rayleigh) != 2:
+            raise InputError(f"--rayleigh = {args.rayleigh}: give ALPHA,BETA")
+        return StructuralDamping.rayleigh(*args.rayleigh)
+    return default
+
+
+def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
+    """The wing, model and flight condition of an analysis command (file defaults, then the
+    command-line options); ``altitudes``: the command sweeps altitudes itself."""
+    from ..aero.atmosphere import isa, isa_ft
+    from ..files.scenario_file import is_scenario_file
+    from ..files.wing_file import AnalysisOptions, resolve_wing
+    from ..system.aeroelastic import AeroelasticModel
+
+    if args.wing.endswith(".toml") and is_scenario_file(args.wing):
+        from ..files.scenario_file import load_scenario
+
+        sc = load_scenario(args.wing)  # a scenario: its wing, flight condition and options
+        wing = sc.wing
+        opts = AnalysisOptions(
+            sc.density,
+            sc.elements,
+            sc.wagner,
+            sc.v_max,
+            altitude=sc.altitude,
+            compressibility=sc.compressibility,
+            damping=sc.damping,
+        )
+    else:
+        wing, opts = resolve_wing(args.wing)
+    atm = None
+    if getattr(args, "altitude", None) is not None:
+        atm = isa(args.altitude)
+    elif getattr(args, "altitude_ft", None) is not None:
+        atm = isa_ft(args.altitude_ft)
+    elif getattr(args, "density", None) is None and opts.altitude is not None:
+        atm = isa(opts.altitude)
+    density = atm.density if atm is not None else (getattr(args, "density", None) or opts.density)
+
+    comp = getattr(args, "compressibility", None) or opts.compressibility
+    comp = None if comp == "none" else comp
+    if comp is not None and atm is None and not altitudes:
+        raise InputError(
+            f"--compressibility = {comp!r}: needs the speed of sound, give --altitude M or "
+            "--altitude-ft FT instead of a density"
+        )
+    elements = args.elements if args.elements is not None else opts.elements
+    wagner = args.wagner if args.wagner is not None else opts.wagner
+    model = AeroelasticModel(wing, elements, wagner, damping=_damping(args, opts.damping))
+    return Setup(wing, model, atm, density, comp, opts)

@@ -1,0 +1,191 @@
+"""The scenario commands: ``run``, ``simulate``, ``trade``, ``plot`` and ``examples``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import InputError
+from .options import positive_int
+
+__all__ = ["add_parsers", "HANDLERS"]
+
+
+def add_parsers(sub) -> None:
+    """The scenario commands' parsers."""
+    for name, helptext in (
+        ("run", "run a scenario of any kind (flutter, simulate, trade)"),
+        ("simulate", "run a closed-loop time simulation scenario"),
+        ("trade", "run a trade-study scenario on Dask"),
+    ):
+        r = sub.add_parser(name, help=helptext, description=helptext.capitalize() + ".")
+        r.add_argument("scenario", help="scenario file (.toml), see docs/scenarios.md")
+        r.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
+        r.add_argument("--json", action="store_true", help="print the summary as JSON")
+        r.add_argument(
+            "--quick",
+            action="store_true",
+            help="fast settings for smoke tests (short simulation, coarse grids, 2 values per "
+            "trade parameter)",
+        )
+        r.add_argument(
+            "--progress",
+            action=argparse.BooleanOptionalAction,
+            default=None,
+            help="progress bars on stderr (default: when stderr is a terminal)",
+        )
+        if name in ("run", "trade"):
+            r.add_argument(
+                "--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://host:port"
+            )
+            r.add_argument(
+                "--workers", type=positive_int, help="LocalCluster workers (default: scenario)"
+            )
+
+    pl = sub.add_parser("plot", help="re-plot a saved simulation result (.npz)")
+    pl.add_argument("result", help="result file written by 'aeroservo simulate'")
+    pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
+
+    sub.add_parser("examples", help="list the built-in wings and the shipped scenarios")
+
+
+def _cmd_examples(args: argparse.Namespace) -> int:
+    from ..files.scenario_file import shipped_scenarios
+    from ..structure.examples import BUILTIN_WINGS
+
+    print("built-in wings:")
+    for name, fn in BUILTIN_WINGS.items():
+        doc = (fn.__doc__ or "").strip().splitlines()[0]
+        print(f"  {name:16s} {doc}")
+    found = shipped_scenarios()
+    if found:
+        print(f"scenarios ({found[0][0].parent}):")
+        for path, kind, title in found:
+            print(f"  {path.name:32s} {kind:9s} {title}")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..files.outputs import write_run
+    from ..files.results import json_text
+    from ..files.scenario_file import load_scenario
+    from ..studies.runs import run_scenario
+    from ..studies.scenario import quick
+
+    scenario = load_scenario(args.scenario)
+    if args.command != "run" and scenario.kind != args.command:
+        raise InputError(
+            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo "
+            f"{'run' if scenario.kind == 'flutter' else scenario.kind}' for it"
+        )
+    if args.quick:
+        scenario = quick(scenario)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    progress = sys.stderr.isatty() if args.progress is None else args.progress
+    run = run_scenario(
+        scenario,
+        out,
+        progress=progress,
+        scheduler=getattr(args, "scheduler", None),
+        workers=getattr(args, "workers", None),
+    )
+    write_run(run, out)
+    summary = run.summary
+    if args.json:
+        print(json_text(summary))
+    else:
+        print(_readable(summary))
+    return 0
+
+
+def _readable(s: dict) -> str:
+    """Short human-readable summary of a run."""
+
+    def f(v, unit="", fmt=".5g"):
+        return "none" if v is None else f"{v:{fmt}}{unit}"
+
+    lines = [f"{s.get('scenario', '')} [{s.get('kind')}]"]
+    if s["kind"] == "flutter":
+        top = s.get("searched_range", [0.0, s.get("v_max")])[1]
+        if s["flutter_speed"] is None:
+            lines.append(f"  no flutter below {top:.5g} m/s")
+        else:
+            lines.append(
+                f"  flutter {f(s['flutter_speed'], ' m/s')} at {f(s['flutter_frequency'], ' Hz')}"
+                f" ({s.get('flutter_mode')})"
+            )
+        lines.append(f"  divergence {f(s['divergence_speed'], ' m/s')}")
+        lines += [f"  warning: {w}" for w in s.get("warnings", [])]
+        if "pk_exact_theodorsen" in s:
+            pk = s["pk_exact_theodorsen"]
+            lines.append(f"  p-k, exact C(k): flutter {f(pk['flutter_speed'], ' m/s')}")
+    elif s["kind"] == "simulate":
+        lines.append(
+            f"  {s['controller']} at {s['speed']:.5g} m/s "
+            f"(open-loop flutter {f(s['open_loop_flutter_speed'], ' m/s')})"
+        )
+        for name, v in s["signals"].items():
+            unit = s["units"].get(name, "")
+            lines.append(
+                f"  {name:24s} peak {v['peak']:10.4g} {unit:6s} rms {v['rms']:10.4g}  "
+                f"last/first {v['growth']:.3g}"
+            )
+        if "response" in s:
+            lines.append(f"  response {s['response']}")
+        if "mpc" in s:
+            m = s["mpc"]
+            lines.append(
+                f"  MPC solve time median {m['solve_time_median'] * 1e3:.3f} ms, "
+                f"p99 {m['solve_time_p99'] * 1e3:.3f} ms, fallbacks {m['fallbacks']}"
+            )
+        if "closed_loop" in s:
+            c = s["closed_loop"]
+            lines.append(
+                f"  closed loop loses stability at {f(c['closed_loop_flutter_speed'], ' m/s')}"
+                f" ({c['closed_loop_instability'] or 'not in range'}); "
+                f"stable intervals {[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
+            )
+    else:
+        lines.append(
+            f"  {s['n_cases']} cases ({s['n_skipped']} already done, {s['n_failed']} failed) in "
+            f"{s['elapsed']:.1f} s, {s['cases_per_second']:.2f} cases/s"
+        )
+        b = s.get("best_case")
+        if b:
+            from ..studies.trade.study import PARAMETERS
+
+            params = ", ".join(f"{k} = {b[k]:g}" for k in PARAMETERS if k in b)
+            lines.append(
+                f"  best suppression margin {b['suppression_margin']:+.1%} ({params}): "
+                f"open loop {f(b['open_loop_flutter_speed'], ' m/s')}, closed loop "
+                f"{f(b.get('closed_loop_flutter_speed'), ' m/s')}, peak hinge moment "
+                f"{f(b.get('hinge_moment_peak'), ' N m')} in the gust"
+            )
+    for k, v in s.get("files", {}).items():
+        lines.append(f"  wrote {k}: {v}")
+    return "\n".join(lines)
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..atomic import save_figure
+    from ..files.results import load_result
+
+    res = load_result(args.result)
+    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
+    save_figure(res.plot(), out, dpi=120)
+    print(f"plot written to {out}")
+    return 0
+
+
+HANDLERS = {
+    "examples": _cmd_examples,
+    "run": _cmd_run,
+    "simulate": _cmd_run,
+    "trade": _cmd_run,
+    "plot": _cmd_plot,
+}

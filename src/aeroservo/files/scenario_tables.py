@@ -1,0 +1,161 @@
+"""Tables of a scenario file with their own rules: the flight condition, the disturbance (gusts,
+a gust series from a CSV file) and the trade study (see :mod:`aeroservo.files.scenario_file`)."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from ..aero.atmosphere import ALTITUDE_RANGE, FT, isa
+from ..design.spec import ControllerSpec
+from ..errors import InputError
+from ..studies.scenario import GUST_KEYS, GUST_TYPES, Disturbance
+from .controller_file import load_controller
+from .toml_tables import Table
+
+__all__ = ["flight", "disturbance", "trade_table", "controller", "is_file"]
+
+
+def disturbance(tbl: Table, base: Path, span: float) -> Disturbance:
+    from ..aero.gusts import GustSeries, OneMinusCosine, Turbulence
+
+    kind = tbl.string("gust", "none", choices=GUST_TYPES)
+    tbl.check_keys((), ("initial_tip", "gust") + GUST_KEYS[kind])
+    tip = tbl.number("initial_tip", 0.0, unit="m", lo=-0.25 * span, hi=0.25 * span)
+    gust = None
+    if kind == "one_minus_cosine":
+        gust = OneMinusCosine(
+            length=tbl.number("length", unit="m", lo=0.0, lo_open=True, required=True),
+            amplitude=tbl.number("amplitude", unit="m/s", lo=-50.0, hi=50.0, required=True),
+            start=tbl.number("start", 0.0, unit="s", lo=0.0),
+        )
+    elif kind == "turbulence":
+        gust = Turbulence(
+            sigma=tbl.number("sigma", unit="m/s", lo=0.0, hi=30.0, required=True),
+            scale=tbl.number("scale", 533.0, unit="m", lo=0.0, lo_open=True),
+            model=tbl.string("model", "von_karman", choices=("von_karman", "dryden")),
+            seed=tbl.integer("seed", 0, lo=0, hi=2**32 - 1),
+        )
+    elif kind == "series":
+        path = tbl.path("file", base, required=True)
+        gust = gust_series(tbl, path, GustSeries)
+    return Disturbance(initial_tip=tip, gust=gust)
+
+
+def gust_series(tbl: Table, path: Path, cls):
+    """CSV with columns time [s], velocity [m/s] (a header line is allowed)."""
+    if not is_file(path):
+        tbl.fail("file", tbl.data["file"], f"no such gust file ({path})")
+    rows = []
+    try:
+        with path.open(newline="", encoding="utf-8") as fh:
+            for i, row in enumerate(csv.reader(fh)):
+                if not row or row[0].strip().startswith("#"):
+                    continue
+                try:
+                    rows.append((float(row[0]), float(row[1])))
+                except (ValueError, IndexError):
+                    if i == 0:
+                        continue  # header
+                    tbl.fail("file", tbl.data["file"], f"line {i + 1}: expected time, velocity")
+    except UnicodeDecodeError:
+        tbl.fail("file", tbl.data["file"], "not a UTF-8 text file")
+    except csv.Error as exc:
+        tbl.fail("file", tbl.data["file"], f"not a CSV file: {exc}")
+    except OSError as exc:
+        tbl.fail("file", tbl.data["file"], f"cannot read the gust file: {exc.strerror}")
+    t = np.array([r[0] for r in rows])
+    w = np.array([r[1] for r in rows])
+    try:
+        return cls(tuple(t), tuple(w))
+    except InputError as exc:
+        tbl.fail("file", tbl.data["file"], str(exc))
+
+
+def flight(fl: Table, kw: dict) -> None:
+    """Density, or an altitude of the standard atmosphere, and the speed."""
+    given = [k for k in ("density", "altitude", "altitude_ft") if fl.has(k)]
+    if not given:
+        raise InputError(
+            f"{fl.file}: flight.density: missing; give density, altitude or altitude_ft"
+        )
+    if len(given) > 1:
+        fl.fail(given[1], fl.data[given[1]], "give one of density, altitude, altitude_ft")
+    kw["altitude"] = None
+    if given[0] == "density":
+        kw["density"] = fl.number("density", unit="kg/m^3", lo=0.0, hi=2.0, lo_open=True)
+    else:
+        ft = given[0] == "altitude_ft"
+        lo, hi = ALTITUDE_RANGE
+        h = fl.number(
+            given[0], unit="ft" if ft else "m", lo=lo / FT if ft else lo, hi=hi / FT if ft else hi
+        )
+        atm = isa(h * FT if ft else h)
+        kw["altitude"], kw["density"] = atm.altitude, atm.density
+
+
+def trade_table(tbl: Table, base: Path) -> dict:
+    """Raw trade settings; validated against the wing by :mod:`aeroservo.studies.trade`."""
+    from ..studies.trade.study import PARAMETERS
+
+    tbl.check_keys(
+        ("controller", "parameters"),
+        (
+            "speed_factor",
+            "gust_length",
+            "gust_amplitude",
+            "gust_duration",
+            "v_max_factor",
+            "n_grid",
+            "workers",
+        ),
+    )
+    spec = controller(tbl, tbl.path("controller", base, required=True), "controller")
+    if spec.type not in ("lqr", "lqg"):
+        tbl.fail(
+            "controller",
+            tbl.data["controller"],
+            f"a trade study needs a linear controller (lqr or lqg), this one is {spec.type!r}",
+        )
+    pt = tbl.table("parameters").check_keys((), tuple(PARAMETERS))
+    params = {}
+    for name in pt.data:
+        params[name] = tuple(pt.numbers(name, lo=0.0, lo_open=name != "hinge_stiffness"))
+        if len(set(params[name])) != len(params[name]):
+            pt.fail(name, pt.data[name], "values must not repeat")
+    if not params:
+        tbl.fail("parameters", tbl.data["parameters"], f"give at least one of {list(PARAMETERS)}")
+    n_cases = int(np.prod([len(v) for v in params.values()]))
+    if n_cases > 1_000_000:
+        tbl.fail("parameters", tbl.data["parameters"], f"{n_cases} cases: the limit is 1 000 000")
+    return {
+        "controller": spec,
+        "parameters": params,
+        "speed_factor": tbl.number("speed_factor", 1.1, lo=0.0, hi=10.0, lo_open=True),
+        "gust_length": tbl.number("gust_length", 25.0, unit="m", lo=0.0, lo_open=True),
+        "gust_amplitude": tbl.number("gust_amplitude", 5.0, unit="m/s", lo=-50.0, hi=50.0),
+        "gust_duration": tbl.number("gust_duration", 1.0, unit="s", lo=0.0, hi=60.0, lo_open=True),
+        "v_max_factor": tbl.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True),
+        "n_grid": tbl.integer("n_grid", 21, lo=3, hi=2000),
+        "workers": tbl.integer("workers", 2, lo=1, hi=256),
+    }
+
+
+def is_file(path: Path) -> bool:
+    """``path.is_file()``, False for names the OS rejects (e.g. too long)."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def controller(ct: Table, path: Path, key: str = "spec") -> ControllerSpec:
+    """The controller file ``path`` named by ``key``; its errors also name this file."""
+    if not is_file(path):
+        ct.fail(key, ct.data[key], f"no such controller file ({path})")
+    try:
+        return load_controller(path)
+    except InputError as exc:
+        raise InputError(f"{ct.file}: {ct.key_name(key)} -> {exc}") from None

@@ -1,0 +1,159 @@
+"""Structural damping ``C_s`` (the seed's equation 1): modal ratios, Rayleigh, structural g.
+
+Three forms, all giving a symmetric damping matrix on the structural unknowns that multiplies
+the rates in ``Ms qdd + C_s qd + Ks q = f_aero``:
+
+* **modal**: a viscous damping ratio ``zeta_j`` per in-vacuo mode (one value for all, or a list
+  for the lowest modes, the last value repeated for the higher ones):
+  ``C_s = Ms Phi diag(2 zeta_j omega_j) Phi^T Ms`` with mass-normalized shapes ``Phi`` of every
+  mode, so that each in-vacuo mode decays at ``zeta_j omega_j``;
+* **Rayleigh**: ``C_s = alpha Ms + beta Ks`` (``zeta_j = alpha / (2 omega_j) + beta omega_j / 2``);
+* **structural g** (Nastran's ``g``): the equivalent viscous ratio ``zeta_j = g / 2`` at every
+  in-vacuo mode (the damping of ``(1 + i g) K`` at resonance).
+
+The matrix does not depend on speed or density: it is built once per model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from ..errors import InputError, check_number
+
+__all__ = ["StructuralDamping", "damping_matrix", "NO_DAMPING"]
+
+KINDS = ("none", "modal", "rayleigh", "structural_g")
+
+
+@dataclass(frozen=True)
+class StructuralDamping:
+    """Structural damping of a model (validated on construction).
+
+    Parameters
+    ----------
+    kind : str
+        ``"none"``, ``"modal"``, ``"rayleigh"`` or ``"structural_g"``.
+    ratios : tuple of float
+        Modal viscous damping ratios [-], lowest mode first (``"modal"``).
+    alpha : float
+        Mass-proportional coefficient [1/s] (``"rayleigh"``).
+    beta : float
+        Stiffness-proportional coefficient [s] (``"rayleigh"``).
+    g : float
+        Structural damping coefficient [-] (``"structural_g"``).
+    """
+
+    kind: str = "none"
+    ratios: tuple = ()
+    alpha: float = 0.0
+    beta: float = 0.0
+    g: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise InputError(f"damping.kind = {self.kind!r}: allowed values are {list(KINDS)}")
+        if self.kind == "modal":
+            r = self.ratios
+            if isinstance(r, (int, float)) and not isinstance(r, bool):
+                r = (r,)
+            if isinstance(r, (str, bytes)) or not isinstance(r, Sequence) or len(r) == 0:
+                raise InputError(
+                    f"damping.ratio = {self.ratios!r}: expected a damping ratio or a list of them"
+                )
+            vals = tuple(
+                check_number(f"damping.ratio[{i}]", v, lo=0.0, hi=1.0, hi_open=True)
+                for i, v in enumerate(r)
+            )
+            object.__setattr__(self, "ratios", vals)
+        if self.kind == "rayleigh":
+            check_number("damping.alpha", self.alpha, unit="1/s", lo=0.0)
+            check_number("damping.beta", self.beta, unit="s", lo=0.0)
+        if self.kind == "structural_g":
+            check_number("damping.g", self.g, lo=0.0, hi=2.0, hi_open=True)
+
+    @classmethod
+    def modal(cls, ratios: float | Sequence[float]) -> StructuralDamping:
+        """Modal viscous damping ratio(s) [-]."""
+        return cls("modal", ratios=ratios)
+
+    @classmethod
+    def rayleigh(cls, alpha: float, beta: float) -> StructuralDamping:
+        """Rayleigh damping ``alpha Ms + beta Ks``."""
+        return cls("rayleigh", alpha=alpha, beta=beta)
+
+    @classmethod
+    def structural(cls, g: float) -> StructuralDamping:
+        """Structural damping g (``zeta = g / 2`` at every in-vacuo mode)."""
+        return cls("structural_g", g=g)
+
+    @property
+    def active(self) -> bool:
+        return self.kind != "none" and (
+            any(self.ratios) or self.alpha or self.beta or self.g or False
+        )
+
+    def describe(self) -> str:
+        """E.g. ``"g = 0.03"``, ``"zeta = 0.02"``, ``"Rayleigh 0.1 M + 1e-4 K"``, ``"none"``."""
+        if self.kind == "modal":
+            r = self.ratios
+            return f"zeta = {r[0]:g}" if len(r) == 1 else "zeta = " + ", ".join(f"{z:g}" for z in r)
+        if self.kind == "rayleigh":
+            return f"Rayleigh {self.alpha:g} M + {self.beta:g} K"
+        if self.kind == "structural_g":
+            return f"g = {self.g:g}"
+        return "none"
+
+    def to_dict(self) -> dict:
+        out: dict = {"kind": self.kind}
+        if self.kind == "modal":
+            out["ratio"] = list(self.ratios)
+        elif self.kind == "rayleigh":
+            out.update(alpha=self.alpha, beta=self.beta)
+        elif self.kind == "structural_g":
+            out["g"] = self.g
+        return out
+
+    def mode_ratios(self, omega: np.ndarray) -> np.ndarray:
+        """Damping ratio of each in-vacuo mode of circular frequencies ``omega`` [rad/s]."""
+        omega = np.asarray(omega, dtype=float)
+        if self.kind == "modal":
+            r = np.asarray(self.ratios)
+            return np.concatenate([r, np.full(max(omega.size - r.size, 0), r[-1])])[: omega.size]
+        if self.kind == "structural_g":
+            return np.full(omega.size, 0.5 * self.g)
+        if self.kind == "rayleigh":
+            w = np.maximum(omega, 1e-300)
+            return self.alpha / (2 * w) + self.beta * w / 2
+        return np.zeros(omega.size)
+
+
+NO_DAMPING = StructuralDamping()
+
+
+def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
+    """The structural damping matrix on the structural unknowns, or None without damping.
+
+    Parameters
+    ----------
+    damping : StructuralDamping
+    Ms, Ks : sparse or ndarray (n, n)
+        Structural mass and stiffness.
+    """
+    if not isinstance(damping, StructuralDamping):
+        raise InputError(f"damping = {damping!r}: expected an aeroservo StructuralDamping")
+    if not damping.active:
+        return None
+    if damping.kind == "rayleigh":
+        return sp.csr_matrix(damping.alpha * Ms + damping.beta * Ks)
+    M = Ms.toarray() if sp.issparse(Ms) else np.asarray(Ms, dtype=float)
+    K = Ks.toarray() if sp.issparse(Ks) else np.asarray(Ks, dtype=float)
+    w2, phi = sla.eigh(K, M)
+    omega = np.sqrt(np.clip(w2, 0.0, None))
+    c = 2.0 * damping.mode_ratios(omega) * omega
+    mp = M @ phi
+    return sp.csr_matrix((mp * c) @ mp.T)
