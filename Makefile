@@ -35,6 +35,7 @@ bench: install
 	$(BIN)/python bench/bench_statespace.py
 	$(BIN)/python bench/bench_control.py
 	$(BIN)/python bench/bench_mpc.py
+	$(BIN)/python bench/bench_mpc_step.py
 	$(BIN)/python bench/bench_trade.py
 
 clean:

@@ -7,13 +7,10 @@ speed, 1 kHz, hinge-moment limits 2000 N m and 2e5 N m/s, initial state: the sta
 
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
-
 import numpy as np
 
 import aeroservo as aes
+from aeroservo._c_stdout import c_stdout_silenced as quiet_stdout  # noqa: F401 (re-export)
 from aeroservo.design import (
     Bryson,
     Limits,
@@ -28,20 +25,6 @@ DT = 1e-3
 CONTROL = "aileron_hinge_moment"
 SENSORS = ["tip_le_accel", "tip_te_accel", "tip_twist"]
 TIP = 0.2  # initial tip deflection [m]
-
-
-@contextlib.contextmanager
-def quiet_stdout():
-    """Silence C-level writes to stdout (qpOASES banner, OSQP polishing notes)."""
-    sys.stdout.flush()
-    saved, null = os.dup(1), os.open(os.devnull, os.O_WRONLY)
-    os.dup2(null, 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(null)
 
 
 def build() -> dict:

@@ -84,14 +84,13 @@ def probe(ctrl, samples) -> str | None:
     opts = {
         k: (dict(v) if isinstance(v, dict) else v) for k, v in SOLVERS[ctrl.solver_name].items()
     }
-    qp = ca.conic(
-        "probe", ctrl.solver_name, {"h": ctrl._H.sparsity(), "a": ctrl._A.sparsity()}, opts
-    )
+    H, A = ca.DM(ctrl.H), ca.DM(ctrl.A_con)
+    qp = ca.conic("probe", ctrl.solver_name, {"h": H.sparsity(), "a": A.sparsity()}, opts)
     for xi in samples:
         t0 = time.perf_counter()
         qp(
-            h=ctrl._H,
-            a=ctrl._A,
+            h=H,
+            a=A,
             **dict(zip(("g", "lbx", "ubx", "lba", "uba"), condensed_qp(ctrl, xi), strict=True)),
         )
         took = time.perf_counter() - t0
@@ -102,9 +101,8 @@ def probe(ctrl, samples) -> str | None:
 
 def condensed_qp(ctrl, xi):
     """``(g, lbx, ubx, lba, uba)`` of the controller's QP at an augmented estimate ``[x, h]``."""
-    x0, h = xi[: ctrl.n_x], xi[ctrl.n_x :]
-    lbx, ubx, lba, uba = ctrl._bounds(x0, h)
-    return 2.0 * (ctrl.G @ x0), lbx, ubx, lba, uba
+    q = ctrl.qp(xi)
+    return q["g"], q["lbx"], q["ubx"], q["lba"], q["uba"]
 
 
 def baseline_opti(ctrl, samples):

@@ -16,7 +16,13 @@ from conftest import ROOT
 SRC = ROOT / "src" / "aeroservo"
 MAX_LINES = 400
 
-BASE = ("aeroservo.errors", "aeroservo._threads", "aeroservo._version", "aeroservo.atomic")
+BASE = (
+    "aeroservo.errors",
+    "aeroservo._threads",
+    "aeroservo._version",
+    "aeroservo.atomic",
+    "aeroservo._c_stdout",
+)
 ORDER = [
     "base",
     "structure",

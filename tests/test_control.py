@@ -204,14 +204,12 @@ def test_mpc_decays_within_limits_and_reports_every_step(case):
 def test_mpc_failed_solve_falls_back_and_carries_on(case):
     M = make_mpc(case, horizon=10)
 
-    class Failing:
-        def __call__(self, **kw):
-            return {"x": np.full(10, np.nan), "lam_x": np.zeros(10), "lam_a": np.zeros(10)}
+    def failing():
+        M._out["x"][:] = np.nan
+        return False, "forced failure"
 
-        def stats(self):
-            return {"success": False, "return_status": "forced failure"}
+    M._solve = failing
 
-    M.solver = Failing()
     r = simulate(
         case.plant(filtered=True), M, duration=0.05, x0=case.x0(filtered=True), limits=LIMITS
     )

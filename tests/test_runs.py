@@ -46,9 +46,15 @@ def test_every_shipped_scenario_runs(path, tmp_path, capsys):
         res = load_result(tmp_path / f"{path.stem}.npz")
         assert res.t[-1] == pytest.approx(0.5)
         spec = load_scenario(path).controller
+        # the verdict agrees with the eigenvalues of the sampled loop (issue 14)
+        assert (summary["verdict"] == "stable") == (summary["spectral_radius"] < 1.0)
+        if "closed_loop" in summary:
+            assert summary["closed_loop"]["stable_at_reference"] == (summary["verdict"] == "stable")
         if spec.type != "none":
-            assert summary["response"] == "decays"
+            assert summary["response"] == "decays" and summary["verdict"] == "stable"
             assert summary["open_loop_unstable"]
+        else:
+            assert summary["verdict"] == "unstable" and summary["expect_unstable"]
 
 
 def test_simulation_summary_and_result_roundtrip(tmp_path):

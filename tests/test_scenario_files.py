@@ -110,7 +110,7 @@ def test_shipped_scenario_loads(name):
 @pytest.mark.parametrize("name", SHIPPED_CONTROLLERS)
 def test_shipped_controller_loads(name):
     spec = load_controller(CONTROLLERS / name)
-    assert spec.type in ("none", "lqr", "lqg", "mpc")
+    assert spec.type in ("none", "lqr", "lqg", "mpc", "hinf")
 
 
 # -- fuzzing: strategies ----------------------------------------------------------------------
@@ -132,9 +132,11 @@ WORDS = sorted(
         initial_tip length amplitude start sigma scale seed spec duration sample_rate delay
         sensor_noise closed_loop_boundary v_max_factor n_grid result plots parameters workers
         type weights limits estimator mpc schedule inputs state_weight magnitude rate
-        process_noise horizon solver soft_outputs slack_weight speed_factors segments
+        process_noise horizon solver soft_outputs slack_weight speed_factors segments hinf margins
+        order sensitivity_peak sensitivity_floor bandwidth control_weight complementary_peak
+        roll_off gamma_factor gain_db phase_deg disk_alpha margin_speeds expect_unstable
         control_surfaces span EI GJ
-        simulate flutter lqr lqg none goland goland_aileron series one_minus_cosine turbulence
+        simulate flutter lqr lqg mpc hinf none goland goland_aileron series one_minus_cosine turbulence
         kussner upwash rt_jones dryden tip_disp tip_twist tip_le_accel tip_accel modal_3
         aileron_hinge_moment aileron_command aileron_deflection aileron_start aileron_chord
         hinge_stiffness bryson_hinge_moment goland_aileron.toml ../controllers/lqr.toml
@@ -271,7 +273,9 @@ SCENARIO_HEAD = st.fixed_dictionaries(
     }
 )
 SCENARIO_TABLES = list(TOP[3:])  # the optional tables, after scenario/wing/flight
-CONTROLLER_HEAD = st.fixed_dictionaries({"type": st.sampled_from(["none", "lqr", "lqg", "mpc"])})
+CONTROLLER_HEAD = st.fixed_dictionaries(
+    {"type": st.sampled_from(["none", "lqr", "lqg", "mpc", "hinf"])}
+)
 CONTROLLER_TABLES = ["weights", "limits", "estimator", "mpc", "schedule"]
 
 

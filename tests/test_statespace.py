@@ -108,37 +108,68 @@ def test_sign_gust_raises_tip():
         assert low_frequency_gain(sys, "tip_disp", "gust") > 0
 
 
-def test_frequency_response_matches_direct_solve(aileron10):
-    """Acceptance: tip acceleration / hinge moment from the state space equals a direct
-    second-order frequency-domain solve with the lag states eliminated term by term (1e-6)."""
-    V = 110.0
-    sys = statespace(
-        aileron10, V, RHO, inputs=["aileron_hinge_moment"], outputs=["tip_le_accel", "tip_te_accel"]
-    )
-    am, wag = aileron10.matrices, aileron10.wagner
+def _direct_response(model, w, V, rows, f):
+    """Second-order frequency-domain solve with the lag states eliminated term by term."""
+    am, wag = model.matrices, model.wagner
     d = lambda m: m.toarray()  # noqa: E731
     scale = 1 - sum(wag.A)
     M = d(am.Ms) + RHO * d(am.Mnc)
     Ca = d(am.Cnc) - scale * d(am.Pd)
     Ka = d(am.Knc) - scale * d(am.Pq)
+    Z = -w * w * M + 1j * w * RHO * V * Ca + d(am.Ks) + RHO * V * V * Ka
+    for a, b in zip(wag.A, wag.b, strict=True):
+        lag = np.linalg.solve(
+            1j * w * d(am.Mz1) + V * b * d(am.Lz1), V * d(am.E1) + 1j * w * d(am.F1)
+        )
+        Z -= RHO * V * V * a * b * d(am.W1) @ lag
+    return np.array([r @ np.linalg.solve(Z, f) for r in rows])
+
+
+def _output_cancellation(sys, w):
+    """(|C||x| + |D||u|) / |y| at ``w``: how much the output sum C x + D u cancels."""
+    A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
+    x = np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B[:, 0])
+    y = C @ x + D[:, 0]
+    return float(((np.abs(C) @ np.abs(x)) + np.abs(D[:, 0])).max() / np.abs(y).max())
+
+
+@pytest.mark.parametrize("kind", ["displacement", "acceleration"])
+def test_frequency_response_matches_direct_solve(aileron10, kind):
+    """Acceptance (issue 14): tip responses to the hinge moment from the balanced state space,
+    evaluated by python-control (``sys(s)`` and ``frequency_response``, slycot's tb05ad when
+    installed), equal an independent second-order frequency-domain solve to 1e-9 of the
+    response. Displacements: 1e-9 at every frequency (the physical realization misses it by up
+    to 1.6e-7, and failed 1e-6 on some BLAS). Accelerations: an acceleration output is a sum
+    C x + D u that cancels at low frequency (the quasi-static balance), by a factor measured
+    here from the model; its rounding, eps times that factor, is added to the tolerance, so the
+    test holds on any BLAS (the tolerance stays under 1.5e-9 from 70 rad/s up)."""
+
     from aeroservo.linear.signals import hinge_moment_vector
 
-    f = hinge_moment_vector(aileron10, 0)
+    V = 110.0
+    suffix = {"displacement": "disp", "acceleration": "accel"}[kind]
+    names = [f"tip_le_{suffix}", f"tip_te_{suffix}"]
     rows = [
-        sensor_row(aileron10, aes.Sensor("le", "acceleration", 6.096, -1.0)),
-        sensor_row(aileron10, aes.Sensor("te", "acceleration", 6.096, 1.0)),
+        sensor_row(aileron10, aes.Sensor("le", kind, 6.096, -1.0)),
+        sensor_row(aileron10, aes.Sensor("te", kind, 6.096, 1.0)),
     ]
-    for w in (5.0, 45.0, 70.0, 140.0, 400.0):
-        Z = -w * w * M + 1j * w * RHO * V * Ca + d(am.Ks) + RHO * V * V * Ka
-        for a, b in zip(wag.A, wag.b, strict=True):
-            lag = np.linalg.solve(
-                1j * w * d(am.Mz1) + V * b * d(am.Lz1), V * d(am.E1) + 1j * w * d(am.F1)
-            )
-            Z -= RHO * V * V * a * b * d(am.W1) @ lag
-        q = np.linalg.solve(Z, f)
-        direct = np.array([-w * w * (r @ q) for r in rows])
+    f = hinge_moment_vector(aileron10, 0)
+    sys = statespace(aileron10, V, RHO, inputs=["aileron_hinge_moment"], outputs=names)
+    assert np.abs(sys.A).max() < 1e6  # the physical realization reaches 1.4e10
+    eps = np.finfo(float).eps
+    for w in (2.0, 5.0, 45.0, 70.0, 140.0, 400.0):
+        direct = _direct_response(aileron10, w, V, rows, f)
+        if kind == "acceleration":
+            direct = -w * w * direct
+            tol = 1e-9 + 10 * eps * _output_cancellation(sys, w)
+        else:
+            tol = 1e-9
         ss = np.asarray(sys(1j * w))[:, 0]
-        np.testing.assert_allclose(ss, direct, rtol=1e-6)
+        fr = sys.frequency_response([w]).complex[:, 0, 0]
+        err = max(np.abs(ss - direct).max(), np.abs(fr - direct).max()) / np.abs(direct).max()
+        assert err < tol, (w, err, tol)
+        if w >= 70.0:
+            assert tol < 1.5e-9
 
 
 def test_root_loads_by_force_summation():
@@ -224,7 +255,8 @@ def test_modal_truncation(aileron10, vf, n_modes):
 
 @pytest.mark.parametrize("speed_factor", [0.9, 1.05])
 def test_balanced_truncation_respects_its_bound(aileron10, vf, speed_factor):
-    """The measured error never exceeds the reported H-infinity bound (unstable modes kept)."""
+    """The error measured on an independent dense grid never exceeds the reported bound of
+    each channel, in its physical units (unstable modes kept)."""
     full = statespace(
         aileron10,
         speed_factor * vf.flutter_speed,
@@ -237,12 +269,43 @@ def test_balanced_truncation_respects_its_bound(aileron10, vf, speed_factor):
         bt = balanced_truncation(full, order)
         assert bt.system.nstates == order
         assert bt.n_unstable == (2 if speed_factor > 1 else 0)
-        err = np.abs(
-            compare_frequency_response(full, bt.system, omega).full
-            - compare_frequency_response(full, bt.system, omega).reduced
-        )
-        assert err.max() <= bt.error_bound * (1 + 1e-6)
+        cmp = compare_frequency_response(full, bt.system, omega)
+        for a, out in enumerate(full.output_labels):
+            for b, inp in enumerate(full.input_labels):
+                err = np.abs(cmp.full[a, b] - cmp.reduced[a, b]).max()
+                peak = np.abs(cmp.full[a, b]).max()
+                assert err <= bt.channel_bounds[out, inp] * (1 + 1e-6) + 1e-9 * peak
     assert np.all(np.diff(bt.hsv) <= 0)
+
+
+def test_balanced_truncation_scales_signals(aileron10, vf):
+    """Issue 14: with metres, radians, m/s^2, N m and m/s mixed, the unscaled truncation's bound
+    (2e-4, dominated by the gust channels) passed a tip-twist / hinge-moment channel with a
+    1.2 % error. Scaled by nominal magnitudes, every channel of the same order is within
+    0.1 %, and each measured channel error is within that channel's own bound."""
+    full = statespace(aileron10, 0.9 * vf.flutter_speed, RHO, n_modes=8)
+    bt = balanced_truncation(full, 20)
+    unscaled = balanced_truncation(full, 20, input_scale=[1.0, 1.0], output_scale=[1.0] * 3)
+    assert (
+        unscaled.error_bound < 1e-3 < unscaled.channel_errors["tip_twist", "aileron_hinge_moment"]
+    )
+    assert bt.max_channel_error < 1e-3
+    for key, err in bt.channel_errors.items():
+        assert err <= bt.relative_bound(*key) * (1 + 1e-6) + 1e-9
+    # default scales: every input's largest scaled peak gain and every output's is one
+    scaled = {
+        k: v * bt.input_scale[k[1]] / bt.output_scale[k[0]] for k, v in bt.channel_peaks.items()
+    }
+    for name in full.output_labels:
+        assert max(v for k, v in scaled.items() if k[0] == name) == pytest.approx(1.0, rel=1e-6)
+    for name in full.input_labels:
+        assert max(v for k, v in scaled.items() if k[1] == name) == pytest.approx(1.0, rel=1e-6)
+    given = balanced_truncation(full, 20, input_scale={"aileron_hinge_moment": 100.0, "gust": 1.0})
+    assert given.input_scale == {"aileron_hinge_moment": 100.0, "gust": 1.0}
+    with pytest.raises(aes.InputError, match="input_scale: unknown signal 'hinge'"):
+        balanced_truncation(full, 20, input_scale={"hinge": 1.0, "gust": 1.0})
+    with pytest.raises(aes.InputError, match="output_scale: need 3 positive"):
+        balanced_truncation(full, 20, output_scale=[1.0, -1.0, 1.0])
 
 
 def test_discretization(aileron10):
@@ -274,6 +337,14 @@ def test_export_roundtrip(tmp_path, aileron10):
         "root_bending_moment",
     ]
     assert list(npz["input_names"]) == sys.input_labels
+    np.testing.assert_array_equal(npz["state_scaling"], sys.state_scaling)
+    np.testing.assert_array_equal(mat["state_scaling"].ravel(), sys.state_scaling)
+    # the physical realization is the balanced one undone by its scaling
+    phys = statespace(aileron10, 120.0, RHO, outputs=["tip_twist"], balanced=False)
+    s = npz["state_scaling"]
+    np.testing.assert_allclose(
+        npz["A"], np.asarray(phys.A) * s[None, :] / s[:, None], rtol=1e-15, atol=0
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["g.mat", "g.npz"]
 
 

@@ -1,6 +1,7 @@
 """The ``aeroservo`` command.
 
-Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure.
+Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure,
+3 a closed-loop simulation whose loop is unstable (unless the scenario expects it).
 Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
 need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``) and
 :mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``plot``, ``examples``).
@@ -9,6 +10,8 @@ need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``) and
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -47,6 +50,35 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+@contextlib.contextmanager
+def _json_stdout():
+    """While a ``--json`` command runs, what C libraries write to file descriptor 1 goes to
+    stderr; Python's ``print`` still reaches the real stdout, so the JSON stays parseable."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no stdout at all
+        yield
+        return
+    original = sys.stdout
+    try:
+        on_fd1 = original.fileno() == 1
+    except (AttributeError, OSError, ValueError):  # e.g. captured by a test harness
+        on_fd1 = False
+    os.dup2(2, 1)
+    if on_fd1:
+        sys.stdout = os.fdopen(os.dup(saved), "w", encoding="utf-8")
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        if on_fd1:
+            sys.stdout.close()
+            sys.stdout = original
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 @blas_limited
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
@@ -58,6 +90,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     handlers = {**analysis.HANDLERS, **scenarios.HANDLERS}
     try:
+        if getattr(args, "json", False):
+            with _json_stdout():
+                return handlers[args.command](args)
         return handlers[args.command](args)
 
     except InputError as exc:

@@ -98,7 +98,47 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(json_text(summary))
     else:
         print(_readable(summary))
+    if summary.get("verdict") == "unstable" and not scenario.expect_unstable:
+        from ..studies.verdict import EXIT_UNSTABLE
+
+        print(f"aeroservo: {summary['hint']}", file=sys.stderr)
+        return EXIT_UNSTABLE
+    margins = summary.get("margins")
+    if margins and not margins["meets"] and summary.get("verdict") == "stable":
+        print(
+            f"aeroservo: warning: loop margins miss the requirement: "
+            f"{'; '.join(margins['violations'])}",
+            file=sys.stderr,
+        )
     return 0
+
+
+def _margin_lines(m: dict | None) -> list[str]:
+    """One line per control channel: gain, phase and disk margins at the actuator."""
+    if not m:
+        return []
+
+    def db(x, sign="+"):
+        return f"{sign}inf" if x is None else f"{x:+.3g} dB"
+
+    r = m["requirement"]
+    req = (
+        f"disk {r['disk_alpha']:g}"
+        if r["disk_alpha"] is not None
+        else f"{r['gain_db']:g} dB, {r['phase_deg']:g} deg"
+    )
+    out = []
+    for name, c in m["channels"].items():
+        if not c["stable"]:
+            out.append(f"  margins at {name}: closed loop unstable")
+            continue
+        pm = "inf" if c["phase_margin_deg"] is None else f"{c['phase_margin_deg']:.3g} deg"
+        out.append(
+            f"  margins at {name}: gain {db(c['gain_margin_db'])} / "
+            f"{db(c['gain_reduction_margin_db'], '-')}, phase {pm}, disk {c['disk_margin']:.3g} "
+            f"({'meets' if m['meets'] else 'misses'} {req})"
+        )
+    return out
 
 
 def _readable(s: dict) -> str:
@@ -131,10 +171,16 @@ def _readable(s: dict) -> str:
             unit = s["units"].get(name, "")
             lines.append(
                 f"  {name:24s} peak {v['peak']:10.4g} {unit:6s} rms {v['rms']:10.4g}  "
-                f"last/first {v['growth']:.3g}"
+                f"growth {v['growth']:.3g}"
             )
-        if "response" in s:
-            lines.append(f"  response {s['response']}")
+        if "verdict" in s:
+            expected = " (expected: simulation.expect_unstable)" if s.get("expect_unstable") else ""
+            lines.append(
+                f"  verdict {s['verdict']}{expected}: spectral radius of the sampled loop "
+                f"{s['spectral_radius']:.6g}, response {s['response']}"
+                + (f" ({', '.join(s['growing_signals'])} grow)" if s["growing_signals"] else "")
+            )
+        lines += _margin_lines(s.get("margins"))
         if "mpc" in s:
             m = s["mpc"]
             lines.append(

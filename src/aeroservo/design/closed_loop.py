@@ -27,6 +27,7 @@ from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
 from ..stability.boundary import sign_changes
 from .plant import SampledPlant, select
+from .sampled_loop import _pad, linear_law, loop_matrix
 
 __all__ = ["ClosedLoopBoundary", "closed_loop_boundary", "closed_loop_matrix"]
 
@@ -36,24 +37,18 @@ def _controller_at(controller, speed: float):
     return controller.at(speed) if hasattr(controller, "at") else controller
 
 
-def _pad(T: np.ndarray, n_plant: int) -> np.ndarray:
-    """State map padded with zero columns for plant states appended after the model's own
-    (e.g. sensor filters of :func:`~aeroservo.design.plant.with_sensor_filters`)."""
-    if T.shape[1] > n_plant:
-        raise InputError(
-            f"state feedback: the gain needs {T.shape[1]} plant states, the plant has {n_plant}"
-        )
-    return np.hstack([T, np.zeros((T.shape[0], n_plant - T.shape[1]))])
-
-
 def closed_loop_matrix(plant, controller, *, sampled: bool = True, delay: bool = False):
     """State matrix of the loop of a linear controller around a plant at one speed.
+
+    The sampled loop is the one :func:`aeroservo.simulate.simulate` marches
+    (:mod:`aeroservo.design.sampled_loop`: with a delay, the estimator predicts with the input
+    actually applied); an MPC controller gives its loop without active constraints.
 
     Parameters
     ----------
     plant : control.StateSpace
         Continuous plant with the controller's control inputs and sensors.
-    controller : StateFeedback or OutputFeedback
+    controller : StateFeedback, OutputFeedback, MPCController or a compensator
         Linear controller (see :mod:`aeroservo.design`).
     sampled : bool
         True: the discrete loop at the controller's sample rate; False: the continuous loop.
@@ -70,26 +65,16 @@ def closed_loop_matrix(plant, controller, *, sampled: bool = True, delay: bool =
     import control
 
     controls = list(controller.controls)
-    if getattr(controller, "needs_state", False):  # state feedback
-        n = plant.nstates
-        if sampled:
-            sp = SampledPlant.from_statespace(plant, controller.dt, controls, (), [])
-            Kx = controller.Kd @ _pad(controller.state_map, n)
-            if not delay:
-                return sp.Phi - sp.Gu @ Kx, controller.dt
-            m = len(controls)
-            A = np.zeros((n + m, n + m))
-            A[:n, :n], A[:n, n:], A[n:, :n] = sp.Phi, sp.Gu, -Kx
-            return A, controller.dt
-        A, B, _, _ = select(plant, controls, [])
-        return A - B @ (controller.K @ _pad(controller.state_map, n)), None
-    sensors = list(controller.sensors)
     if sampled:
-        sp = SampledPlant.from_statespace(plant, controller.dt, controls, (), sensors)
-        loop = control.feedback(sp.as_statespace(delay=delay), controller.compensator, sign=1)
-        return np.asarray(loop.A), controller.dt
+        law = linear_law(controller, plant.nstates)
+        sp = SampledPlant.from_statespace(plant, controller.dt, controls, (), list(law.sensors))
+        return loop_matrix(sp, law, delay), controller.dt
     if delay:
         raise InputError("closed_loop_matrix: delay applies to the sampled loop only")
+    if getattr(controller, "needs_state", False):  # state feedback
+        A, B, _, _ = select(plant, controls, [])
+        return A - B @ (controller.K @ _pad(controller.state_map, plant.nstates)), None
+    sensors = list(controller.sensors)
     A, B, C, D = select(plant, controls, sensors)
     p = control.ss(A, B, C, D)
     comp = controller.compensator_continuous
@@ -126,6 +111,8 @@ class ClosedLoopBoundary:
         in increasing speed; ``static`` marks a real pole through zero (divergence-like, 0 Hz).
     sampled : bool
         Whether the measure is that of the sampled loop.
+    delay : bool
+        Whether the loop has a one-sample computational delay.
     reference_speed : float
         Speed [m/s] whose stable interval defines :attr:`flutter_speed`.
     """
@@ -137,11 +124,15 @@ class ClosedLoopBoundary:
     sampled: bool
     reference_speed: float
     info: dict = field(default_factory=dict)
+    delay: bool = False
+    reference_abscissa: float | None = None
 
     @property
     def stable_at_reference(self) -> bool:
-        """Whether the loop is stable at the reference (e.g. design) speed."""
-        return bool(self._g(self.reference_speed) < 0)
+        """Whether the loop is stable at the reference (e.g. design) speed (from its own
+        eigenvalues when computed, else interpolated on the grid)."""
+        g = self.reference_abscissa
+        return bool((self._g(self.reference_speed) if g is None else g) < 0)
 
     def _g(self, v: float) -> float:
         return float(np.interp(v, self.speeds, self.abscissa))
@@ -168,17 +159,24 @@ class ClosedLoopBoundary:
         return None if f is None else float(f["frequency"])
 
     def stable_intervals(self) -> list[tuple[float, float]]:
-        """Speed intervals [m/s] inside the searched range where the loop is stable."""
+        """Speed intervals [m/s] inside the searched range where the loop is stable.
+
+        Between two crossings the loop is stable after a recovery and unstable after an onset
+        (the crossing kinds come from the refined roots, not from the coarse grid, which can
+        step over a short unstable interval); before the first crossing it is the opposite of
+        that crossing.
+        """
         edges = [self.speeds[0]] + [c["speed"] for c in self.crossings] + [self.speeds[-1]]
+        if self.crossings:
+            first = self.crossings[0]["kind"] == "onset"
+            stable = [first] + [c["kind"] == "recovery" for c in self.crossings]
+        else:
+            stable = [bool(np.all(self.abscissa < 0))]
         out = []
-        for a, b in zip(edges[:-1], edges[1:], strict=True):
-            if b > a and self._g_mid(a, b) < 0:
+        for a, b, ok in zip(edges[:-1], edges[1:], stable, strict=True):
+            if b > a and ok:
                 out.append((float(a), float(b)))
         return out
-
-    def _g_mid(self, a: float, b: float) -> float:
-        inside = (self.speeds > a) & (self.speeds < b)
-        return float(np.max(self.abscissa[inside])) if inside.any() else self._g(0.5 * (a + b))
 
     def to_dict(self) -> dict:
         """JSON-ready summary (m/s, Hz)."""
@@ -194,6 +192,7 @@ class ClosedLoopBoundary:
             "reference_speed": self.reference_speed,
             "stable_at_reference": self.stable_at_reference,
             "sampled": self.sampled,
+            "delay": self.delay,
             "crossings": self.crossings,
             "stable_intervals": self.stable_intervals(),
             "v_range": [float(self.speeds[0]), float(self.speeds[-1])],
@@ -332,6 +331,7 @@ def closed_loop_boundary(
                 "static": bool(abs(lc.imag) <= 1e-6 * max(abs(lc.real), 1.0)),
             }
         )
+    g_ref = evaluate(float(reference_speed))[0] if v_min <= reference_speed <= v_max else None
     return ClosedLoopBoundary(
         speeds=V,
         abscissa=g,
@@ -340,6 +340,8 @@ def closed_loop_boundary(
         sampled=sampled,
         reference_speed=float(reference_speed),
         info={"n_evaluations": n_eval[0]},
+        delay=bool(delay),
+        reference_abscissa=g_ref,
     )
 
 

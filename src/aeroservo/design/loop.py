@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import InputError, check_int, check_number
 from ..linear.models import tip_deflection_state
 from ..linear.state_space import StateSpaceBuilder
+from .hinf import hinf
 from .lqg import lqg
 from .lqr import Bryson, lqr
 from .mpc import mpc
@@ -157,12 +158,26 @@ class ControlLoop:
 
         Returns
         -------
-        OpenLoop, StateFeedback, OutputFeedback, GainSchedule or MPCController
+        OpenLoop, StateFeedback, OutputFeedback, GainSchedule, MPCController or
+        DiscreteCompensator
         """
         self.check_spec(spec)
         rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
         if spec.type == "none":
             return OpenLoop(tuple(self.controls), 1.0 / rate)
+        if spec.type == "hinf":
+            try:
+                return hinf(
+                    self.design(speed),
+                    self.controls,
+                    self.sensors,
+                    input_scale=spec.bryson_inputs,
+                    sensor_scale=spec.sensor_scales,
+                    weights=spec.hinf,
+                    sample_rate=rate,
+                )
+            except (InputError, ArithmeticError) as exc:
+                raise type(exc)(f"{spec.source}: {exc}") from None
         if spec.type == "mpc":
             return mpc(
                 self.design(speed),
@@ -221,6 +236,7 @@ def check_spec_signals(
     allowed = {
         "weights.outputs": outputs,
         "weights.inputs": list(controls),
+        "weights.sensors": list(sensors),
         "limits.magnitude": list(controls),
         "limits.rate": list(controls),
         "estimator.process_noise": ["gust"],
@@ -233,10 +249,17 @@ def check_spec_signals(
                 raise InputError(
                     f"{spec.source}: {key}.{n}: not a signal of this loop; allowed {allowed[key]}"
                 )
-    if spec.type in ("lqr", "lqg", "mpc"):
+    if spec.type in ("lqr", "lqg", "mpc", "hinf"):
         missing = [c for c in controls if c not in spec.bryson_inputs]
         if missing:
             raise InputError(f"{spec.source}: weights.inputs: give an allowed value for {missing}")
+    if spec.type == "hinf":
+        missing = [s for s in sensors if s not in spec.sensor_scales]
+        if missing:
+            raise InputError(
+                f"{spec.source}: weights.sensors: give a nominal magnitude for {missing}"
+            )
+
     if spec.type in ("lqg", "mpc"):
         missing = [s for s in sensors if s not in spec.sensor_noise]
         if missing:

@@ -17,16 +17,13 @@ records ``fallback=True`` with the solver's status for that sample, and carries 
 
 from __future__ import annotations
 
-import contextlib
-import io
-import os
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._c_stdout import c_stdout_silenced
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
 from .lqg import KalmanFilter, kalman_filter, solve_dare
@@ -45,11 +42,13 @@ SOLVERS = {
     },
     "daqp": {"error_on_fail": False},
 }
-"""casadi conic solvers offered and their options. ``bench/bench_control.py`` measures them on
-the Goland-with-aileron MPC (horizon 20, 1 kHz, limits active on 28 % of the samples): DAQP
-(dual active set) median 0.41 ms, p99 0.50 ms, the default; qpOASES (primal active set)
-0.45 / 0.61 ms; OSQP (ADMM) 0.81 / 1.9 ms. HiGHS was tried and dropped: its QP solver cycled
-on this problem (millions of iterations without progress), so a step never returned."""
+"""casadi conic solvers offered and their options. ``bench/bench_mpc.py`` measures them on the
+Goland-with-aileron MPC (horizon 20, 1 kHz, limits active on 28 % of the samples), called
+through casadi's zero-copy buffers: DAQP (dual active set) median 0.05 ms, p99 0.12 ms, the
+default; qpOASES (primal active set) 0.06 / 0.17 ms; OSQP (ADMM) 0.46 / 1.2 ms. (Called with
+numpy arguments, the conversions alone cost ~0.25 ms per step.) HiGHS was tried and dropped:
+its QP solver cycled on this problem (millions of iterations without progress), so a step never
+returned."""
 
 
 @dataclass
@@ -91,67 +90,106 @@ class MPCController:
     solve_times: list = field(default_factory=list)
     statuses: list = field(default_factory=list)
     fallbacks: int = 0
-    _warm: dict | None = None
 
     def reset(self) -> None:
         self.kf.reset()
         self.solve_times = []
         self.statuses = []
         self.fallbacks = 0
-        self._warm = None
         self.last_status = None
+        self._bind()
 
-    def _bounds(self, x0: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _bind(self) -> None:
+        """Bind numpy arrays to the solver's inputs and outputs (casadi's zero-copy buffers:
+        converting numpy arguments cost ~40 us each, four times the QP's own solve time).
+
+        Constant inputs (H, A, the magnitude bounds) are set once; per sample only the linear
+        term, the rate and soft-output bounds and the warm start change, in place.
+        """
         N, m = self.horizon, self.u_max.size
-        ns = self.z_max.size * N
-        lbx = np.r_[np.tile(-self.u_max, N), np.zeros(ns)]
-        ubx = np.r_[np.tile(self.u_max, N), np.full(ns, np.inf)]
+        nu, ns = N * m, self.z_max.size * N
+        self._nu, self._ns = nu, ns
         du = np.tile(self.du_max * self.dt, N)
-        shift = np.zeros(N * m)
-        shift[:m] = h
-        lb_rate, ub_rate = -du + shift, du + shift
+        zm = np.tile(self.z_max, N)
+        self._du0 = du[:m].copy()
+        self._zm = zm
+        values = {
+            "h": np.asarray(self.H, dtype=float).ravel(order="F"),
+            "a": np.asarray(self.A_con, dtype=float).ravel(order="F"),
+            "g": np.zeros(nu + ns),
+            "lbx": np.r_[np.tile(-self.u_max, N), np.zeros(ns)],
+            "ubx": np.r_[np.tile(self.u_max, N), np.full(ns, np.inf)],
+            "lba": np.r_[-du, np.full(ns, -np.inf), -zm],
+            "uba": np.r_[du, zm, np.full(ns, np.inf)],
+        }
+        buf, self._eval = self.solver.buffer()
+        self._buf, self._in, self._out = buf, {}, {}
+        for k, name in enumerate(self.solver.name_in()):
+            arr = values.get(name)
+            if arr is None:
+                arr = np.zeros(self.solver.sparsity_in(k).nnz())
+            self._in[name] = arr
+            buf.set_arg(k, memoryview(arr))
+        for k, name in enumerate(self.solver.name_out()):
+            self._out[name] = np.zeros(self.solver.sparsity_out(k).nnz())
+            buf.set_res(k, memoryview(self._out[name]))
+
+    def _fill(self, xi: np.ndarray, a: dict) -> tuple[np.ndarray, np.ndarray]:
+        """Write the estimate-dependent terms of the QP at ``xi = [x, h]`` into ``a`` (the
+        linear term, the first rate bounds, the soft-output bounds); returns ``(x, h)``."""
+        x0, h = xi[: self.n_x], xi[self.n_x :]
+        m, nu, ns = self.u_max.size, self._nu, self._ns
+        np.dot(self.G, x0, out=a["g"][:nu])
+        a["g"][:nu] *= 2.0
+        a["lba"][:m] = h - self._du0
+        a["uba"][:m] = h + self._du0
         if ns:
             zfree = self.Tx_out @ x0
-            zm = np.tile(self.z_max, N)
-            lb = np.r_[lb_rate, np.full(ns, -np.inf), -zm - zfree]
-            ub = np.r_[ub_rate, zm - zfree, np.full(ns, np.inf)]
+            np.subtract(self._zm, zfree, out=a["uba"][nu : nu + ns])
+            np.subtract(-self._zm, zfree, out=a["lba"][nu + ns :])
+        return x0, h
+
+    def qp(self, xi: np.ndarray) -> dict:
+        """The QP solved at an augmented estimate ``xi = [x, h]``: ``h, a`` (dense arrays) and
+        ``g, lbx, ubx, lba, uba`` (vectors), in the solver's (scaled) cost units."""
+        out = {k: self._in[k].copy() for k in ("g", "lbx", "ubx", "lba", "uba")}
+        self._fill(xi, out)
+        out["h"], out["a"] = np.asarray(self.H), np.asarray(self.A_con)
+        return out
+
+    def _solve(self) -> tuple[bool, str]:
+        """Solve the bound QP in place; ``(success, solver status)``."""
+        if self.solver_name == "osqp":  # OSQP prints "Polishing not needed ..." on C stdout
+            with c_stdout_silenced():
+                self._eval()
         else:
-            lb, ub = lb_rate, ub_rate
-        return lbx, ubx, lb, ub
+            self._eval()
+        stats = self._buf.stats()
+        return bool(stats.get("success", False)), str(stats.get("return_status", "unknown"))
 
     def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
-        xi = self.kf.correct(y)
-        x0, h = xi[: self.n_x], xi[self.n_x :]
-        m = self.u_max.size
-        g = 2.0 * (self.G @ x0)
-        ns = self.z_max.size * self.horizon
-        g = np.r_[g, np.zeros(ns)]
-        lbx, ubx, lba, uba = self._bounds(x0, h)
-        args = {"h": self._H, "a": self._A, "g": g, "lbx": lbx, "ubx": ubx, "lba": lba, "uba": uba}
-        if self._warm is not None:
-            args.update(self._warm)
+        a, o = self._in, self._out
+        x0, h = self._fill(self.kf.correct(y), a)
+        m, nu = self.u_max.size, self._nu
         t0 = time.perf_counter()
-        sol = self.solver(**args)
+        ok, status = self._solve()
         dt_solve = time.perf_counter() - t0
-        stats = self.solver.stats()
-        ok = bool(stats.get("success", False))
-        status = str(stats.get("return_status", "unknown"))
-        U = np.asarray(sol["x"]).ravel()
+        U = o["x"]
         if ok and np.all(np.isfinite(U)):
-            u0 = U[:m]
-            nu = m * self.horizon
-            shifted = np.r_[U[m:nu], U[nu - m : nu], U[nu:]]
-            self._warm = {
-                "x0": shifted,
-                "lam_x0": np.asarray(sol["lam_x"]).ravel(),
-                "lam_a0": np.asarray(sol["lam_a"]).ravel(),
-            }
+            u0 = U[:m].copy()
+            w = a["x0"]  # warm start: the solution shifted by one sample
+            w[: nu - m] = U[m:nu]
+            w[nu - m : nu] = U[nu - m : nu]
+            w[nu:] = U[nu:]
+            a["lam_x0"][:] = o["lam_x"]
+            a["lam_a0"][:] = o["lam_a"]
             fallback = False
         else:
             u_lqr = -(self.K_fallback @ x0)
             u0 = np.clip(u_lqr, h - self.du_max * self.dt, h + self.du_max * self.dt)
             u0 = np.clip(u0, -self.u_max, self.u_max)
-            self._warm = None
+            for name in ("x0", "lam_x0", "lam_a0"):  # cold start next time
+                a[name][:] = 0.0
             self.fallbacks += 1
             fallback = True
         self.solve_times.append(dt_solve)
@@ -162,36 +200,13 @@ class MPCController:
     def update(self, y: np.ndarray, u: np.ndarray) -> None:
         self.kf.predict(u)
 
-
-@contextlib.contextmanager
-def _c_stdout_silenced():
-    """Send what C code writes to the process's stdout to /dev/null for a moment, so that
-    machine-readable output on stdout (``--json``) is not corrupted."""
-    sys.stdout.flush()
-    fd = 1  # C code writes to file descriptor 1 whatever sys.stdout is
-    try:
-        saved = os.dup(fd)
-    except OSError:  # no stdout at all
-        with contextlib.redirect_stdout(io.StringIO()):
-            yield
-        return
-    try:
-        with open(os.devnull, "wb") as null, contextlib.redirect_stdout(io.StringIO()):
-            os.dup2(null.fileno(), fd)  # casadi prints through Python's sys.stdout, plugins
-            yield  # may print through C stdio: silence both
-            _flush_c_stdio()  # C stdio buffers output to a pipe: flush it into /dev/null
-    finally:
-        os.dup2(saved, fd)
-        os.close(saved)
-
-
-def _flush_c_stdio() -> None:
-    import ctypes
-
-    try:
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError):  # no C library to flush (not on this platform)
-        pass
+    def unconstrained_gain(self) -> np.ndarray:
+        """Gain ``K`` with ``c = -K xi+`` of the MPC without active constraints (its first move
+        as a linear function of the estimate: the MPC's loop as an LQG)."""
+        nu = self.horizon * self.u_max.size
+        m = self.u_max.size
+        k0 = 2.0 * np.linalg.solve(self.H[:nu, :nu], self.G)[:m]
+        return np.hstack([k0, np.zeros((m, self.kf.Ad.shape[0] - self.n_x))])
 
 
 def _condensed(Phi, Gu, Q, R, N, P, horizon):
@@ -323,7 +338,7 @@ def mpc(
     cost_scale = 1.0 / max(float(np.max(np.diag(Hs))), 1e-300)
     H_full = 2.0 * cost_scale * Hs
     G = cost_scale * G
-    with _c_stdout_silenced():  # qpOASES prints a licence banner on stdout at creation
+    with c_stdout_silenced():  # qpOASES prints a licence banner on stdout at creation
         conic = ca.conic(
             "aeroservo_mpc",
             solver,
@@ -348,7 +363,5 @@ def mpc(
         solver_name=solver,
         solver=conic,
     )
-    ctrl._H = ca.DM(H_full)
-    ctrl._A = ca.DM(A_con)
     ctrl.reset()
     return ctrl

@@ -187,12 +187,13 @@ class SampledPlant:
         )
 
 
-def state_map(plant_builder, design_builder) -> np.ndarray:
+def state_map(plant_builder, design_builder, *, balanced: bool = True) -> np.ndarray:
     """Matrix T with ``x_design = T x_plant`` between two builders of the same wing model.
 
     The design builder may be a modal truncation of the plant builder (``n_modes``): modal
     coordinates are ``eta = Phi^T Ms q`` (mass-normalized modes), their rates likewise; lag, gust
-    and servo states are shared.
+    and servo states are shared. ``balanced`` (default, as the builders' models): between the
+    scaled states of :meth:`StateSpaceBuilder.at`; False: between the physical ones.
     """
     if plant_builder.model is not design_builder.model:
         raise InputError("state_map: the builders must use the same AeroelasticModel")
@@ -203,7 +204,7 @@ def state_map(plant_builder, design_builder) -> np.ndarray:
     n_p, n_d = plant_builder.n_states, design_builder.n_states
     n_q = plant_builder.model.n_dofs
     if design_builder.n_modes is None:
-        return np.eye(n_p)
+        return np.eye(n_p)  # the same builder kind: the same scaling
     r = design_builder.n_modes
     phi = design_builder.basis
     proj = phi.T @ plant_builder.model.matrices.Ms.toarray()
@@ -214,6 +215,8 @@ def state_map(plant_builder, design_builder) -> np.ndarray:
     if rest != n_d - 2 * r:
         raise InputError("state_map: the non-structural states of the two models differ")
     T[2 * r :, 2 * n_q :] = np.eye(rest)
+    if balanced:
+        T = T * (1.0 / design_builder.state_scaling)[:, None] * plant_builder.state_scaling[None, :]
     return T
 
 

@@ -7,12 +7,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .hinf import HinfWeights
+from .margins import MarginRequirement
 from .plant import Limits
 
 __all__ = ["ControllerSpec", "CONTROLLER_TYPES"]
 
 
-CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc")
+CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc", "hinf")
 
 
 @dataclass(frozen=True)
@@ -23,10 +25,18 @@ class ControllerSpec:
     ----------
     type : str
         ``"none"`` (open loop), ``"lqr"`` (full-state feedback), ``"lqg"`` (Kalman filter on
-        the sensors + LQR) or ``"mpc"`` (constrained MPC, casadi, Kalman filter).
+        the sensors + LQR), ``"mpc"`` (constrained MPC, casadi, Kalman filter) or ``"hinf"``
+        (H-infinity mixed sensitivity at the actuator).
     name : str
     bryson_outputs, bryson_inputs : dict
-        Allowed output and control values (Bryson's rule), in the signals' units.
+        Allowed output and control values (Bryson's rule), in the signals' units; for
+        ``"hinf"`` the inputs are the controls' nominal magnitudes.
+    sensor_scales : dict
+        Nominal sensor magnitudes (``"hinf"``), in the sensors' units.
+    hinf : HinfWeights or None
+        Mixed-sensitivity weights (``"hinf"``).
+    margins : MarginRequirement
+        Loop-margin requirement at the actuator the runs check (default MIL-F-9490D).
     state_weight : float
         Small regularizing weight on all states (relative).
     limits : Limits
@@ -63,6 +73,9 @@ class ControllerSpec:
     soft_outputs: dict = field(default_factory=dict)
     slack_weight: float = 1e4
     schedule: tuple | None = None
+    sensor_scales: dict = field(default_factory=dict)
+    hinf: HinfWeights | None = None
+    margins: MarginRequirement = field(default_factory=MarginRequirement)
     source: str = "<dict>"
 
     @property
@@ -71,6 +84,7 @@ class ControllerSpec:
         return {
             "weights.outputs": list(self.bryson_outputs),
             "weights.inputs": list(self.bryson_inputs),
+            "weights.sensors": list(self.sensor_scales),
             "limits.magnitude": list(self.limits.magnitude),
             "limits.rate": list(self.limits.rate),
             "estimator.process_noise": list(self.process_noise),

@@ -1,8 +1,9 @@
 """Controller specification files (``controllers/*.toml``, schema in ``docs/scenarios.md``).
 
 A controller file describes *how* to design a flutter-suppression controller, independently of
-the wing: the type (``lqr``, ``lqg``, ``mpc`` or ``none`` for the open loop), Bryson weights,
-actuator limits, estimator noise levels, MPC settings and an optional gain schedule. Scenarios
+the wing: the type (``lqr``, ``lqg``, ``mpc``, ``hinf`` or ``none`` for the open loop), Bryson
+weights or nominal magnitudes, actuator limits, estimator noise levels, MPC settings,
+H-infinity weights, an optional gain schedule and the loop-margin requirement. Scenarios
 refer to it by path, so one wing can be tried with many controllers. Signal names are checked
 against the wing's model when a scenario is resolved.
 """
@@ -11,6 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..design.hinf import HinfWeights
+from ..design.margins import MarginRequirement
 from ..design.mpc import SOLVERS
 from ..design.plant import Limits
 from ..design.spec import CONTROLLER_TYPES, ControllerSpec
@@ -19,7 +22,19 @@ from .toml_tables import Table, check_integers, one_line_errors, read_toml
 __all__ = ["load_controller", "controller_from_dict"]
 
 
-TOP_KEYS = ("type", "name", "description", "weights", "limits", "estimator", "mpc", "schedule")
+TOP_KEYS = (
+    "type",
+    "name",
+    "description",
+    "weights",
+    "limits",
+    "estimator",
+    "mpc",
+    "schedule",
+    "hinf",
+    "margins",
+)
+HINF_KEYS = tuple(HinfWeights.__dataclass_fields__)
 
 
 def controller_from_dict(data: object, file: str = "<dict>") -> ControllerSpec:
@@ -39,12 +54,14 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "lqr": ("weights",),
         "lqg": ("weights", "estimator"),
         "mpc": ("weights", "estimator", "limits"),
+        "hinf": ("weights",),
     }[kind]
     allowed = {
         "none": ("limits",),
-        "lqr": ("weights", "limits", "schedule"),
-        "lqg": ("weights", "estimator", "limits", "schedule"),
-        "mpc": ("weights", "estimator", "limits", "mpc"),
+        "lqr": ("weights", "limits", "schedule", "margins"),
+        "lqg": ("weights", "estimator", "limits", "schedule", "margins"),
+        "mpc": ("weights", "estimator", "limits", "mpc", "margins"),
+        "hinf": ("weights", "limits", "hinf", "margins"),
     }[kind]
     for key in TOP_KEYS[3:]:
         if top.has(key) and key not in allowed:
@@ -52,15 +69,46 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         if key in needs and not top.has(key):
             raise_missing(top, key, kind)
 
-    w = top.table("weights").check_keys(
-        ("outputs", "inputs") if top.has("weights") else (), ("state_weight",)
+    if kind == "hinf":
+        w = top.table("weights").check_keys(("inputs", "sensors"))
+        kw["bryson_inputs"] = w.number_map("inputs")
+        kw["sensor_scales"] = w.number_map("sensors")
+        for key in ("inputs", "sensors"):
+            if not w.number_map(key):
+                w.fail(key, w.data[key], "give a nominal magnitude per signal")
+        h = top.table("hinf").check_keys((), HINF_KEYS)
+        d = HinfWeights()
+        kw["hinf"] = HinfWeights(
+            order=h.integer("order", d.order, lo=1, hi=1000),
+            **{
+                k: h.number(
+                    k,
+                    getattr(d, k),
+                    unit="Hz" if k in ("bandwidth", "roll_off") else "",
+                    lo=1.0 if k == "gamma_factor" else 0.0,
+                    lo_open=True,
+                )
+                for k in HINF_KEYS
+                if k != "order"
+            },
+        )
+    else:
+        w = top.table("weights").check_keys(
+            ("outputs", "inputs") if top.has("weights") else (), ("state_weight",)
+        )
+        kw["bryson_outputs"] = w.number_map("outputs")
+        kw["bryson_inputs"] = w.number_map("inputs")
+        if top.has("weights") and (not kw["bryson_outputs"] or not kw["bryson_inputs"]):
+            key = "outputs" if not kw["bryson_outputs"] else "inputs"
+            w.fail(key, w.data[key], "give at least one allowed value")
+        kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0)
+    mg = top.table("margins").check_keys((), ("gain_db", "phase_deg", "disk_alpha"))
+    req = MarginRequirement()
+    kw["margins"] = MarginRequirement(
+        gain_db=mg.number("gain_db", req.gain_db, lo=0.0),
+        phase_deg=mg.number("phase_deg", req.phase_deg, lo=0.0, hi=180.0),
+        disk_alpha=mg.number("disk_alpha", None, lo=0.0, hi=2.0, lo_open=True),
     )
-    kw["bryson_outputs"] = w.number_map("outputs")
-    kw["bryson_inputs"] = w.number_map("inputs")
-    if top.has("weights") and (not kw["bryson_outputs"] or not kw["bryson_inputs"]):
-        key = "outputs" if not kw["bryson_outputs"] else "inputs"
-        w.fail(key, w.data[key], "give at least one allowed value")
-    kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0)
 
     lim = top.table("limits").check_keys((), ("magnitude", "rate"))
     kw["limits"] = Limits(magnitude=lim.number_map("magnitude"), rate=lim.number_map("rate"))

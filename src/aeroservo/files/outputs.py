@@ -1,8 +1,11 @@
 """The outputs of a scenario run, written as one set (:func:`write_run`).
 
 A flutter run writes ``<result>.json`` and ``<result>_vg.png``; a simulation writes
-``<result>.npz`` (:mod:`aeroservo.files.results`), ``<result>.png``, ``<result>_boundary.png``
-when the closed-loop boundary was computed, and ``<result>.json``; a trade study writes
+``<result>.npz`` (:mod:`aeroservo.files.results`), ``<result>.png``, ``<result>_margins.png``
+(Nyquist and Bode at the actuator) for a controlled loop, ``<result>_boundary.png`` and
+``<result>_margin_sweep.png`` when the closed-loop boundary was computed, and
+``<result>.json``; a trade study writes
+
 ``summary.json``, ``heatmap.png`` and ``pareto.png`` into its folder (next to its case store,
 CSV and NetCDF). Every file of a run is renamed into place only when all of them have been
 written (:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
@@ -64,6 +67,17 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
                 png = out / f"{sc.result}_boundary.png"
                 fig = run.boundary.plot(open_loop=run.flutter)
                 add("boundary_plot", png, figure_writer(fig, png, dpi=120))
+            if run.margins is not None:
+                from ..plots import plot_loop_margins, plot_margin_sweep
+
+                png = out / f"{sc.result}_margins.png"
+                fig = plot_loop_margins(run.margins, title=sc.name)
+                add("margins_plot", png, figure_writer(fig, png, dpi=120))
+                if run.margin_sweep is not None:
+                    png = out / f"{sc.result}_margin_sweep.png"
+                    fig = plot_margin_sweep(run.margin_sweep, title=sc.name)
+                    add("margin_sweep_plot", png, figure_writer(fig, png, dpi=120))
+
         json_path = out / f"{sc.result}.json"
         files["summary"] = str(json_path)
     else:

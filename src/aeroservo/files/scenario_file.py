@@ -185,18 +185,22 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["filter_order"] = sg.integer("filter_order", 2, lo=1, hi=4)
 
     sim = top.table("simulation").check_keys(
-        (), ("duration", "sample_rate", "delay", "seed", "sensor_noise")
+        (), ("duration", "sample_rate", "delay", "seed", "sensor_noise", "expect_unstable")
     )
+    kw["expect_unstable"] = sim.boolean("expect_unstable", False)
     kw["duration"] = sim.number("duration", 2.0, unit="s", lo=0.0, hi=600.0, lo_open=True)
     kw["sample_rate"] = sim.number("sample_rate", 1000.0, unit="Hz", lo=1.0, hi=1.0e5)
     kw["delay"] = sim.boolean("delay", False)
     kw["seed"] = sim.integer("seed", 0, lo=0, hi=2**32 - 1)
     kw["sensor_noise"] = sim.number_map("sensor_noise", lo=0.0, lo_open=False)
 
-    an = top.table("analysis").check_keys((), ("closed_loop_boundary", "v_max_factor", "n_grid"))
+    an = top.table("analysis").check_keys(
+        (), ("closed_loop_boundary", "v_max_factor", "n_grid", "margin_speeds")
+    )
     kw["closed_loop_boundary"] = an.boolean("closed_loop_boundary", False)
     kw["v_max_factor"] = an.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True)
     kw["n_grid"] = an.integer("n_grid", 41, lo=3, hi=2000)
+    kw["margin_speeds"] = an.integer("margin_speeds", 9, lo=0, hi=200)
 
     out = top.table("output").check_keys((), ("result", "plots"))
     stem = Path(file).stem if file != "<dict>" else "scenario"

@@ -1,5 +1,6 @@
 """State-space models written for MATLAB (``.mat``) and NumPy (``.npz``): A, B, C, D with the
-signal names and units, speed, density and sample time.
+signal names and units, speed, density, sample time and the state scaling of a balanced
+realization (``x_physical = state_scaling .* x``).
 """
 
 from __future__ import annotations
@@ -31,11 +32,15 @@ def _export_dict(sys) -> dict:
         "speed": float(getattr(sys, "speed", np.nan)),
         "density": float(getattr(sys, "density", np.nan)),
         "dt": 0.0 if sys.dt in (0, None) else float(sys.dt),
+        "state_scaling": np.asarray(
+            getattr(sys, "state_scaling", np.ones(sys.nstates)), dtype=float
+        ),
     }
 
 
 def export_mat(sys, path: str | Path) -> Path:
-    """Write ``A, B, C, D``, signal names and units, speed, density and dt to a MATLAB file."""
+    """Write ``A, B, C, D``, names and units, speed, density, dt and state_scaling (MATLAB)."""
+
     from scipy.io import savemat
 
     data = _export_dict(sys)

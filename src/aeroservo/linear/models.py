@@ -67,6 +67,7 @@ def statespace(
     gust: str = "kussner",
     kussner: object = "sears_sparks",
     n_modes: int | None = None,
+    balanced: bool = True,
 ):
     """Linear state-space model of a wing at one flight condition.
 
@@ -83,6 +84,10 @@ def statespace(
         leading/trailing-edge accelerations and tip twist out).
     servo, gust, kussner, n_modes :
         See :class:`StateSpaceBuilder`.
+    balanced : bool
+        True (default): diagonally scaled states (same transfer function and state names,
+        ``x_physical = sys.state_scaling * x``); False: the physical states, see
+        :meth:`StateSpaceBuilder.at`.
 
     Returns
     -------
@@ -94,7 +99,7 @@ def statespace(
     b = _builder_for(
         model, density, inputs, outputs, servo=servo, gust=gust, kussner=kussner, n_modes=n_modes
     )
-    return b.at(speed)
+    return b.at(speed, balanced=balanced)
 
 
 def statespace_family(
@@ -106,8 +111,9 @@ def statespace_family(
     """
     n_el = kw.pop("n_elements", 10)
     wag = kw.pop("wagner", "rt_jones")
+    balanced = kw.pop("balanced", True)
     model = _model_for(wing, n_el, wag)
-    return _builder_for(model, density, inputs, outputs, **kw).family(speeds)
+    return _builder_for(model, density, inputs, outputs, **kw).family(speeds, balanced=balanced)
 
 
 def discretize(sys, sample_rate: float):
@@ -116,14 +122,17 @@ def discretize(sys, sample_rate: float):
     d = sys.sample(1.0 / rate, method="zoh")
     if hasattr(sys, "speed"):
         _tag(d, sys.speed, sys.density, sys.signal_units)
+    if hasattr(sys, "state_scaling"):
+        d.state_scaling = sys.state_scaling
     return d
 
 
-def tip_deflection_state(builder, tip: float) -> np.ndarray:
+def tip_deflection_state(builder, tip: float, *, balanced: bool = True) -> np.ndarray:
     """Initial state: the static shape under a tip load, scaled to a tip deflection ``tip`` [m].
 
     Rates, lag, gust and servo states are zero. ``builder`` is the plant's
-    :class:`~aeroservo.linear.state_space.StateSpaceBuilder` (full model).
+    :class:`~aeroservo.linear.state_space.StateSpaceBuilder` (full model); ``balanced``
+    (default, as its models): in the scaled states of ``builder.at``; False: physical states.
     """
     check_number("tip", tip, unit="m")
     if builder.n_modes is not None:
@@ -134,4 +143,4 @@ def tip_deflection_state(builder, tip: float) -> np.ndarray:
     q = np.linalg.solve(model.matrices.Ks.toarray(), f)
     x = np.zeros(builder.n_states)
     x[: model.n_dofs] = q * (tip / q[model.mesh.dof_w[-1]])
-    return x
+    return x / builder.state_scaling if balanced else x

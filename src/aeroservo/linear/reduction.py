@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,19 +34,46 @@ class BalancedTruncation:
     Attributes
     ----------
     system : control.StateSpace
-        The reduced model (same input and output names).
+        The reduced model (same input and output names, physical signal units).
     hsv : ndarray
-        Hankel singular values of the stable part, decreasing.
+        Hankel singular values of the stable part of the scaled model, decreasing.
     n_unstable : int
         Unstable (and marginal) modes, kept exactly.
     error_bound : float
-        H-infinity bound on the error ``|G - G_r|`` (in the units of the outputs per input).
+        H-infinity bound on the error of the *scaled* model (dimensionless: outputs divided by
+        ``output_scale``, inputs in units of ``input_scale``).
+    input_scale, output_scale : dict
+        Nominal magnitude of each signal [its SI unit], given or defaulted.
+    channel_bounds : dict
+        ``(output, input) -> error_bound * output_scale / input_scale``: the bound on
+        ``|G_ij - G_r,ij|`` in the channel's physical units.
+    channel_errors : dict
+        ``(output, input) -> max |G_r,ij - G_ij| / max |G_ij|`` over ``omega``, measured.
+    channel_peaks : dict
+        ``(output, input) -> max |G_ij|`` over ``omega`` (physical units).
+    omega : ndarray
+        The logarithmic frequency grid [rad/s] of the default scales and of the measured errors.
     """
 
     system: object
     hsv: np.ndarray
     n_unstable: int
     error_bound: float
+    input_scale: dict = field(default_factory=dict)
+    output_scale: dict = field(default_factory=dict)
+    channel_bounds: dict = field(default_factory=dict)
+    channel_errors: dict = field(default_factory=dict)
+    channel_peaks: dict = field(default_factory=dict)
+    omega: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def max_channel_error(self) -> float:
+        """Largest measured relative channel error."""
+        return max(self.channel_errors.values(), default=0.0)
+
+    def relative_bound(self, output: str, input: str) -> float:
+        """The bound of one channel relative to its peak gain (compare with its error)."""
+        return self.channel_bounds[output, input] / self.channel_peaks[output, input]
 
 
 def _stable_part(
@@ -77,54 +105,148 @@ def _hankel_singular_values(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.n
     return np.linalg.svd(lo @ lc.T, compute_uv=False)
 
 
-def balanced_truncation(sys, order: int, method: str = "truncate") -> BalancedTruncation:
-    """Balanced truncation to ``order`` states, with its error bound.
+def _response_grid(A: np.ndarray) -> np.ndarray:
+    """Logarithmic grid [rad/s] over the model's dynamics: a decade beyond its poles."""
+    mag = np.abs(np.linalg.eigvals(A)) if A.size else np.array([1.0])
+    mag = mag[mag > 0] if np.any(mag > 0) else np.array([1.0])
+    return np.geomspace(mag.min() / 10.0, mag.max() * 10.0, 400)
 
-    The realization is first equilibrated by a diagonal similarity (LAPACK balancing; the
-    transfer function is unchanged), which the badly scaled structural matrices need.
 
-    Parameters
-    ----------
-    sys : control.StateSpace
-        Continuous-time model.
-    order : int
-        States kept (including every unstable mode).
-    method : {"truncate", "matchdc"}
-        Passed to :func:`control.balanced_reduction`.
+def _scales(names, given, what: str) -> np.ndarray | None:
+    """Nominal magnitudes from a dict or sequence (None: to be defaulted)."""
+    if given is None:
+        return None
+    if isinstance(given, dict):
+        unknown = sorted(set(given) - set(names))
+        if unknown:
+            raise InputError(f"{what}: unknown signal {unknown[0]!r}; signals are {list(names)}")
+        missing = [n for n in names if n not in given]
+        if missing:
+            raise InputError(f"{what}: no nominal magnitude for {missing[0]!r}")
+        given = [given[n] for n in names]
+    vals = np.asarray(given, dtype=float).ravel()
+    if vals.size != len(names) or not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise InputError(f"{what}: need {len(names)} positive finite magnitudes, got {given!r}")
+    return vals
 
-    Returns
-    -------
-    BalancedTruncation
 
-    Notes
-    -----
-    For acceleration outputs the high-frequency structural modes carry large Hankel singular
-    values, so the bound (and the error) in a low-frequency band can stay large: truncate the
-    structure modally first (``n_modes``), then balance.
+def _equilibrate(peak: np.ndarray, u0: np.ndarray | None, y0: np.ndarray | None):
+    """Default nominal magnitudes ``(u0, y0)`` from the peak-gain matrix [y_i / u_j].
+
+    Each free side is chosen so that the scaled peak gains ``peak * u0 / y0`` have unit row
+    (column) maxima; both free: alternating square-root (Ruiz) steps. Given sides stay fixed.
+    """
+    tiny = np.finfo(float).tiny
+    p = np.maximum(peak, tiny)
+    if u0 is not None and y0 is not None:
+        return u0, y0
+    if u0 is not None:
+        return u0, (p * u0[None, :]).max(axis=1)
+    if y0 is not None:
+        return 1.0 / (p / y0[:, None]).max(axis=0), y0
+    u, y = np.ones(p.shape[1]), np.ones(p.shape[0])
+    for _ in range(50):
+        y *= np.sqrt((p * u[None, :] / y[:, None]).max(axis=1))
+        u /= np.sqrt((p * u[None, :] / y[:, None]).max(axis=0))
+    return u, y
+
+
+def balanced_truncation(
+    sys,
+    order: int,
+    method: str = "truncate",
+    *,
+    input_scale=None,
+    output_scale=None,
+) -> BalancedTruncation:
+    """Balanced truncation to ``order`` states of the signal-scaled model, with its error bound.
+
+       The inputs and outputs are first divided by nominal magnitudes, so that the truncation and
+       its bound do not mix metres, radians and newton-metres; the realization is equilibrated by a
+       diagonal similarity (LAPACK balancing; the transfer function is unchanged). The reduced
+       model is returned in physical units, with per-channel bounds and measured errors.
+
+       Parameters
+       ----------
+       sys : control.StateSpace
+           Continuous-time model.
+       order : int
+           States kept (including every unstable mode; fewer if the model's minimal realization
+           has fewer).
+       method : {"truncate", "matchdc"}
+           Passed to :func:`control.balanced_reduction`.
+       input_scale, output_scale
+    : dict or sequence, optional
+           Nominal magnitude of each input / output [SI unit of the signal], e.g.
+           ``{"aileron_hinge_moment": 100.0, "gust": 1.0}``. Default: the peak frequency-response
+           gains equilibrated so that each input's largest response and each output's largest
+           excitation have unit peak (a side that is given stays fixed).
+
+       Returns
+       -------
+       BalancedTruncation
+
+       Notes
+       -----
+       For acceleration outputs the high-frequency structural modes carry large Hankel singular
+       values, so the bound (and the error) in a low-frequency band can stay large: truncate the
+       structure modally first (``n_modes``), then balance. A weak channel can still have a
+       relative bound above one (``relative_bound``): give it a smaller nominal magnitude.
     """
     import control
 
     order = check_int("order", order, lo=1, hi=sys.nstates)
-    A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
+    A, B, C, D = (np.asarray(x, dtype=float) for x in (sys.A, sys.B, sys.C, sys.D))
     lam = np.linalg.eigvals(A)
     if np.any(np.abs(lam.real) <= 1e-10 * np.maximum(np.abs(lam), 1.0)):
         raise InputError(
             "balanced_truncation: the model has eigenvalues on the imaginary axis (e.g. lag "
             "states at V = 0); reduce a model at a nonzero speed away from the flutter speed"
         )
+    ins, outs = tuple(sys.input_labels), tuple(sys.output_labels)
+    u0 = _scales(ins, input_scale, "input_scale")
+    y0 = _scales(outs, output_scale, "output_scale")
+    omega = _response_grid(A)
+    g = _frf(sys, omega)
+    peak = np.abs(g).max(axis=2)
+    u0, y0 = _equilibrate(peak, u0, y0)
     A, T = sla.matrix_balance(A, permute=False, separate=False)
-    B, C = np.linalg.solve(T, B), C @ T
-    a11, b1, c1, n_u = _stable_part(A, B, C)
+    Bs, Cs = np.linalg.solve(T, B) * u0[None, :], (C @ T) / y0[:, None]
+    Ds = D * u0[None, :] / y0[:, None]
+    a11, b1, c1, n_u = _stable_part(A, Bs, Cs)
     if order < n_u:
         raise InputError(f"order = {order}: the model has {n_u} unstable states that must be kept")
     hsv = _hankel_singular_values(a11, b1, c1)
     bound = 2.0 * float(np.sum(hsv[order - n_u :]))
-    red = control.balanced_reduction(control.ss(A, B, C, D), order, method=method)
-    red = control.ss(red.A, red.B, red.C, red.D, inputs=sys.input_labels, outputs=sys.output_labels)
+    with warnings.catch_warnings():  # order above the minimal one: slycot keeps the minimal
+        warnings.filterwarnings("ignore", message=r"(?s).*nsmin")
+        red = control.balanced_reduction(control.ss(A, Bs, Cs, Ds), order, method=method)
+    red = control.ss(
+        red.A,
+        np.asarray(red.B) / u0[None, :],
+        np.asarray(red.C) * y0[:, None],
+        np.asarray(red.D) * y0[:, None] / u0[None, :],
+        inputs=list(ins),
+        outputs=list(outs),
+    )
     for attr in ("speed", "density", "signal_units"):
         if hasattr(sys, attr):
             setattr(red, attr, getattr(sys, attr))
-    return BalancedTruncation(red, hsv, n_u, bound)
+    err = np.abs(_frf(red, omega) - g).max(axis=2) / np.where(peak > 0, peak, 1.0)
+    pairs = [(o, i) for o in outs for i in ins]
+    idx = {(o, i): (a, b) for a, o in enumerate(outs) for b, i in enumerate(ins)}
+    return BalancedTruncation(
+        red,
+        hsv,
+        n_u,
+        bound,
+        input_scale=dict(zip(ins, u0.tolist(), strict=True)),
+        output_scale=dict(zip(outs, y0.tolist(), strict=True)),
+        channel_bounds={p: bound * y0[idx[p][0]] / u0[idx[p][1]] for p in pairs},
+        channel_errors={p: float(err[idx[p]]) for p in pairs},
+        channel_peaks={p: float(peak[idx[p]]) for p in pairs},
+        omega=omega,
+    )
 
 
 @dataclass

@@ -18,12 +18,13 @@ import re
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.sparse as sp
+import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..aero.indicial import IndicialSet, kussner_set
 from ..errors import InputError, check_number
 from ..system.first_order import check_mach, compressibility_factors, first_order
+from .polynomial import _dense, _Poly
 from .servo import Servo, servos_of
 from .signals import (
     Sensor,
@@ -38,49 +39,6 @@ from .signals import (
 )
 
 __all__ = ["Servo", "StateSpaceBuilder"]
-
-
-class _Poly:
-    """Matrix polynomial ``sum_k V^k c[k]``."""
-
-    __slots__ = ("c",)
-
-    def __init__(self, c: np.ndarray):
-        self.c = np.asarray(c, dtype=float)
-
-    @classmethod
-    def const(cls, m: np.ndarray) -> _Poly:
-        return cls(np.asarray(m, dtype=float)[None])
-
-    def __add__(self, other: _Poly) -> _Poly:
-        k = max(self.c.shape[0], other.c.shape[0])
-        out = np.zeros((k,) + self.c.shape[1:])
-        out[: self.c.shape[0]] += self.c
-        out[: other.c.shape[0]] += other.c
-        return _Poly(out)
-
-    def __matmul__(self, other: _Poly) -> _Poly:
-        k = self.c.shape[0] + other.c.shape[0] - 1
-        out = np.zeros((k, self.c.shape[1], other.c.shape[2]))
-        for i in range(self.c.shape[0]):
-            for j in range(other.c.shape[0]):
-                out[i + j] += self.c[i] @ other.c[j]
-        return _Poly(out)
-
-    def left(self, m: np.ndarray) -> _Poly:
-        """``m @ self`` for a constant matrix m."""
-        return _Poly(np.einsum("ij,kjl->kil", m, self.c))
-
-    def __call__(self, v: float) -> np.ndarray:
-        out = self.c[-1].copy()
-        for k in range(self.c.shape[0] - 2, -1, -1):
-            out *= v
-            out += self.c[k]
-        return out
-
-
-def _dense(m) -> np.ndarray:
-    return m.toarray() if sp.issparse(m) else np.asarray(m, dtype=float)
 
 
 class StateSpaceBuilder:
@@ -323,21 +281,57 @@ class StateSpaceBuilder:
         self.input_labels = tuple(d.name for d in self.inputs)
         self.output_labels = tuple(d.name for d in self.outputs)
         self.units = {d.name: d.unit for d in self.inputs} | output_units(self.outputs)
+        self._scaling: np.ndarray | None = None
 
     def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(A, B, C, D)`` at ``speed`` [m/s]."""
         v = check_number("speed", speed, unit="m/s", lo=0.0)
         return self._A(v), self._B(v), self._C(v), self._D(v)
 
-    def at(self, speed: float):
+    @property
+    def state_scaling(self) -> np.ndarray:
+        """Diagonal state scaling ``s`` of the balanced models: ``x_physical = s * x``.
+
+        Powers of two (exact), from :func:`scipy.linalg.matrix_balance` of the state matrix at
+        a reference speed (twice the semichord times the second frequency at rest), the same
+        at every speed, so that a family of models shares one state basis.
+        """
+        if self._scaling is None:
+            lam, _ = self.system.modes_at_rest(min(2, self.system.n_q))
+            v_ref = 2.0 * self.model.semichord * float(np.abs(lam[-1]))
+            A = self._A(v_ref)
+            _, (scale, _perm) = sla.matrix_balance(A, permute=False, separate=True)
+            self._scaling = np.asarray(scale, dtype=float)
+        return self._scaling
+
+    def at(self, speed: float, *, balanced: bool = True):
         """``control.StateSpace`` at ``speed`` [m/s], with named signals.
 
-        The returned object carries ``speed`` [m/s], ``density`` [kg/m^3] and
-        ``signal_units`` (dict) attributes.
+        Parameters
+        ----------
+        speed : float
+            [m/s]
+        balanced : bool
+            True (default): the states scaled by :attr:`state_scaling` (the same transfer
+            function, state names kept, entries of A within a few decades instead of 1e10:
+            frequency responses and controller syntheses on it are accurate); False: the
+            physical states (metres, radians, their rates, the lag states), as needed to set
+            initial states such as :func:`aeroservo.linear.models.tip_deflection_state`.
+
+        Returns
+        -------
+        control.StateSpace
+            With attributes ``speed`` [m/s], ``density`` [kg/m^3], ``signal_units`` (dict) and
+            ``state_scaling`` (``x_physical = state_scaling * x``; ones when not balanced).
         """
         import control
 
         A, B, C, D = self.matrices(speed)
+        s = self.state_scaling if balanced else np.ones(A.shape[0])
+        if balanced:
+            A = A * (1.0 / s)[:, None] * s[None, :]
+            B = B / s[:, None]
+            C = C * s[None, :]
         sys = control.StateSpace(
             A,
             B,
@@ -349,11 +343,12 @@ class StateSpaceBuilder:
             name=_system_name(self.model.wing.name, float(speed)),
         )
         _tag(sys, float(speed), self.density, self.units)
+        sys.state_scaling = s
         return sys
 
-    def family(self, speeds: Sequence[float]) -> list:
-        """Models at every speed of a grid [m/s] (no re-assembly)."""
-        return [self.at(v) for v in speeds]
+    def family(self, speeds: Sequence[float], *, balanced: bool = True) -> list:
+        """Models at every speed of a grid [m/s] (no re-assembly; one state scaling)."""
+        return [self.at(v, balanced=balanced) for v in speeds]
 
 
 def _system_name(wing_name: str, speed: float) -> str:

@@ -72,6 +72,18 @@ class SimulationResult:
             for i, (c, u) in enumerate(self.applied.items())
         }
 
+    def rate_limited_fraction(self) -> dict:
+        """Share of samples at which each control moved at its rate limit (the command was
+        rate-limited; the first sample starts from zero)."""
+        _, rate = self.limits.arrays(list(self.applied))
+        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
+        out = {}
+        for i, (c, u) in enumerate(self.applied.items()):
+            step = np.abs(np.diff(np.r_[0.0, np.asarray(u, dtype=float)]))
+            limited = np.isfinite(rate[i]) & (step >= rate[i] * dt * (1 - 1e-9))
+            out[c] = float(np.mean(limited)) if dt > 0 else 0.0
+        return out
+
     def plot(
         self, tip: str | None = None, control: str | None = None, deflection: str | None = None
     ):

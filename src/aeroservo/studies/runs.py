@@ -17,7 +17,9 @@ import numpy as np
 
 from .._threads import blas_limited
 from ..errors import InputError
+from .loop_analysis import analyse_loop
 from .scenario import Scenario
+from .verdict import loop_verdict, signal_growth
 
 __all__ = ["Run", "run_scenario", "run_flutter", "run_simulation", "study_from_scenario"]
 
@@ -37,6 +39,10 @@ class Run:
         Time histories (simulate scenarios).
     boundary : ClosedLoopBoundary or None
         Closed-loop boundary, when the scenario asks for it.
+    margins : LoopMargins or None
+        Loop margins at the actuator at the scenario's speed (controlled loops).
+    margin_sweep : MarginSweep or None
+        The margins over the boundary's speed range, when the boundary is computed.
     trade : TradeResult or None
         Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
     folder : Path or None
@@ -50,6 +56,8 @@ class Run:
     flutter: object = None
     simulation: object = None
     boundary: object = None
+    margins: object = None
+    margin_sweep: object = None
     trade: object = None
     folder: Path | None = None
     title: str = ""
@@ -127,12 +135,6 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
     return Run(scenario, summary, flutter=fr, title=title)
 
 
-def _envelope_ratio(y: np.ndarray, frac: float = 0.2) -> float:
-    n = max(1, int(frac * y.size))
-    first = np.abs(y[:n]).max()
-    return float(np.abs(y[-n:]).max() / first) if first > 0 else float("nan")
-
-
 @blas_limited
 def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     """Closed-loop time simulation of a ``simulate`` scenario.
@@ -144,7 +146,6 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         summary (speeds [m/s], peaks and RMS in the signals' units, growth ratio of the
         response, closed-loop flutter speed if asked).
     """
-    from ..design.closed_loop import closed_loop_boundary
     from ..simulate.march import simulate
     from ..stability.boundary import flutter_boundary
 
@@ -198,6 +199,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         "n_plant_states": plant.nstates,
         "signals": {},
         "saturated_fraction": result.saturated_fraction(),
+        "rate_limited_fraction": result.rate_limited_fraction(),
         "units": dict(result.units),
     }
     for group in (result.outputs, result.applied):
@@ -205,12 +207,15 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
             summary["signals"][name] = {
                 "peak": float(np.abs(y).max()),
                 "rms": float(np.sqrt(np.mean(y**2))),
-                "growth": _envelope_ratio(y),
+                "growth": signal_growth(y),
             }
-    tip = next((n for n in result.outputs if n.startswith("tip_")), None)
-    if tip is not None:
-        g = summary["signals"][tip]["growth"]
-        summary["response"] = "decays" if g < 1 else "grows"
+    at = controller.at(speed) if hasattr(controller, "at") else controller
+    sat, rl = summary["saturated_fraction"], summary["rate_limited_fraction"]
+    limited = {c: max(sat[c], rl[c]) for c in sat}
+    summary.update(loop_verdict(plant, at, scenario.delay, summary["signals"], limited))
+
+    summary["expect_unstable"] = scenario.expect_unstable
+    summary["response"] = "grows" if summary["growing_signals"] else "decays"
     if result.status:
         times = np.array([s["solve_time"] for s in result.status])
         summary["mpc"] = {
@@ -219,26 +224,25 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
             "fallbacks": int(sum(s["fallback"] for s in result.status)),
             "statuses": sorted({s["status"] for s in result.status}),
         }
-    boundary = None
-    if scenario.closed_loop_boundary and spec.type in ("lqr", "lqg"):
-        v_top = scenario.v_max_factor * (vf or speed)
-        update, close = _progress_bar(v_top, "closed-loop sweep", progress)
-        try:
-            boundary = closed_loop_boundary(
-                loop.plant,
-                controller,
-                v_top,
-                n_grid=scenario.n_grid,
-                reference_speed=speed,
-                progress=update,
-            )
-        finally:
-            close()
-        summary["closed_loop"] = boundary.to_dict()
-        if vf is not None and boundary.flutter_speed is not None:
-            summary["closed_loop"]["flutter_speed_increase"] = boundary.flutter_speed / vf - 1
+    analysis = analyse_loop(
+        scenario,
+        loop,
+        controller,
+        speed,
+        vf,
+        lambda total, label: _progress_bar(total, label, progress),
+    )
+    summary.update(analysis.summary(vf))
     summary["wall_time"] = time.perf_counter() - t0
-    return Run(scenario, summary, flutter=fr, simulation=result, boundary=boundary)
+    return Run(
+        scenario,
+        summary,
+        flutter=fr,
+        simulation=result,
+        boundary=analysis.boundary,
+        margins=analysis.margins,
+        margin_sweep=analysis.sweep,
+    )
 
 
 @blas_limited

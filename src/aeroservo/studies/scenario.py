@@ -72,11 +72,13 @@ class Scenario:
     duration: float = 2.0
     sample_rate: float = 1000.0
     delay: bool = False
+    expect_unstable: bool = False
     seed: int = 0
     sensor_noise: dict = field(default_factory=dict)
     closed_loop_boundary: bool = False
     v_max_factor: float = 2.0
     n_grid: int = 41
+    margin_speeds: int = 9
     result: str = ""
     plots: bool = True
     trade: object = None
@@ -113,10 +115,16 @@ class Scenario:
 
 def quick(s: Scenario) -> Scenario:
     """Fast settings of a scenario for smoke tests: at most 0.5 s simulated, an 11-point
-    closed-loop grid, two values per trade parameter and a 0.3 s gust in trade studies."""
+    closed-loop grid, 3 margin speeds, two values per trade parameter and a 0.3 s gust in
+    trade studies."""
     from dataclasses import replace
 
-    kw: dict = {"duration": min(s.duration, 0.5), "n_grid": min(s.n_grid, 11)}
+    kw: dict = {
+        "duration": min(s.duration, 0.5),
+        "n_grid": min(s.n_grid, 11),
+        "margin_speeds": min(s.margin_speeds, 3),
+    }
+
     if s.trade is not None:
         t = dict(s.trade)
         t["parameters"] = {k: v[:2] for k, v in t["parameters"].items()}

@@ -1,4 +1,4 @@
-"""Figures: V-g / V-f diagrams, root locus, mode shapes.
+"""Figures of open-loop results: V-g / V-f diagrams, root locus, mode shapes, flutter envelope.
 
 Functions return :class:`matplotlib.figure.Figure` objects built without ``pyplot`` (no GUI
 backend needed; they display inline in notebooks and save with ``fig.savefig``).
@@ -13,8 +13,8 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-    from .stability.result import FlutterResult
-    from .system.aeroelastic import AeroelasticModel, NaturalModes
+    from ..stability.result import FlutterResult
+    from ..system.aeroelastic import AeroelasticModel, NaturalModes
 
 __all__ = ["plot_vg", "plot_root_locus", "plot_mode_shapes", "plot_envelope"]
 
@@ -48,7 +48,7 @@ def plot_vg(
     units : {"si", "knots"}
         Speed axis in m/s or knots (TAS).
     """
-    from .aero.atmosphere import KNOT
+    from ..aero.atmosphere import KNOT
 
     scale = 1 / KNOT if units == "knots" else 1.0
     fig = _figure(figsize=(7.0, 6.5))
@@ -115,10 +115,10 @@ def plot_envelope(envelope, *, units: str = "si", x: str = "eas") -> Figure:
     x : {"eas", "mach"}
         Horizontal axis.
     """
-    from .aero.atmosphere import KNOT
+    from ..aero.atmosphere import KNOT
 
     if x not in ("eas", "mach"):
-        from .errors import InputError
+        from ..errors import InputError
 
         raise InputError(f"x = {x!r}: allowed values are 'eas', 'mach'")
     fig = _figure(figsize=(6.5, 5.5))

@@ -1,0 +1,180 @@
+"""Figures of loop margins at the actuator: Nyquist and broken-loop Bode diagrams of one channel,
+and the margins versus airspeed (:mod:`aeroservo.design.margins`, ``margin_sweep``)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from ..design.margin_sweep import MarginSweep
+    from ..design.margins import LoopMargins
+
+__all__ = ["plot_loop_margins", "plot_margin_sweep"]
+
+
+def _figure(**kw) -> Figure:
+    from matplotlib.figure import Figure
+
+    return Figure(layout="constrained", **kw)
+
+
+def _disk(ax, size: float, **kw) -> None:
+    """The points -1/f of the balanced disk of gain-phase variations f of size alpha."""
+    if not 0 < size < 2:
+        return
+    a, b = (2 - size) / (2 + size), (2 + size) / (2 - size)
+
+    t = np.linspace(0, 2 * np.pi, 200)
+    c, r = -(a + b) / 2, (b - a) / 2
+    ax.fill(c + r * np.cos(t), r * np.sin(t), **kw)
+
+
+def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: str | None = None):
+    """Nyquist diagram (left, zoomed on -1) and broken-loop Bode diagram (right) of one control
+    channel, with its gain, phase and disk margins and the requirement.
+
+    Parameters
+    ----------
+    margins : LoopMargins
+    control : str, optional
+        Channel (default the first).
+    title : str, optional
+    """
+    control = control or next(iter(margins.channels))
+    ch = margins.channels[control]
+    req = margins.requirement
+    fig = _figure(figsize=(11.0, 5.2))
+    grid = fig.add_gridspec(2, 2, width_ratios=[1.0, 1.25])
+    ax_n = fig.add_subplot(grid[:, 0])
+    ax_m = fig.add_subplot(grid[0, 1])
+    ax_p = fig.add_subplot(grid[1, 1], sharex=ax_m)
+    L = ch.response
+    f = ch.omega / (2 * np.pi)
+
+    # Nyquist: the requirement region, the disk the loop clears, L and its mirror image
+    k = 10 ** (req.gain_db / 20)
+    t = np.radians(np.linspace(-req.phase_deg, req.phase_deg, 60))
+    ax_n.plot(-np.cos(t), np.sin(t), color="tab:orange", lw=3, alpha=0.5)
+    ax_n.plot(
+        [-k, -1 / k],
+        [0, 0],
+        color="tab:orange",
+        lw=3,
+        alpha=0.5,
+        label=f"requirement: {req.gain_db:g} dB, {req.phase_deg:g} deg",
+    )
+    _disk(
+        ax_n,
+        ch.disk_margin,
+        color="tab:red",
+        alpha=0.15,
+        label=f"disk margin alpha = {ch.disk_margin:.3g}",
+    )
+    ax_n.plot(L.real, L.imag, "C0", lw=1.2, label="L(e^{j w dt}), 0 to Nyquist")
+    ax_n.plot(L.real, -L.imag, "C0", lw=0.8, ls="--", alpha=0.6)
+    u = np.linspace(0, 2 * np.pi, 200)
+    ax_n.plot(np.cos(u), np.sin(u), color="0.6", lw=0.8, ls=":")
+    ax_n.plot(-1, 0, "r+", ms=12, mew=2)
+    ax_n.set_xlim(-3.0, 1.5)
+    ax_n.set_ylim(-2.25, 2.25)
+    ax_n.set_aspect("equal")
+    ax_n.set_xlabel("Re L")
+    ax_n.set_ylabel("Im L")
+    ax_n.grid(True, alpha=0.3)
+    verdict = "stable" if ch.stable else "UNSTABLE"
+    ax_n.set_title(
+        f"Nyquist: {ch.open_loop_unstable} unstable open-loop poles, "
+        f"{ch.encirclements:.0f} encirclements of -1 ({verdict})",
+        fontsize=9,
+    )
+    ax_n.legend(fontsize=7, loc="lower left")
+
+    # Bode of the return ratio
+    keep = f > 0
+    ax_m.semilogx(f[keep], 20 * np.log10(np.maximum(np.abs(L[keep]), 1e-300)), "C0")
+    ax_m.axhline(0, color="k", lw=0.8)
+    ax_p.semilogx(f[keep], np.degrees(np.angle(-L[keep])), "C0")
+    ax_p.axhline(0, color="k", lw=0.8)
+    marks = (
+        (ch.gain_frequencies[0], f"gain reduction {ch.gain_reduction_margin_db:.3g} dB", "C3"),
+        (ch.gain_frequencies[1], f"gain increase {ch.gain_margin_db:.3g} dB", "C1"),
+        (ch.phase_frequency, f"phase {ch.phase_margin_deg:.3g} deg", "C2"),
+        (ch.disk_frequency, f"disk alpha {ch.disk_margin:.3g}", "C4"),
+    )
+    for x, lab, color in marks:
+        if x:
+            ax_m.axvline(x, color=color, lw=0.9, ls="--", label=f"{lab} at {x:.3g} Hz")
+            ax_p.axvline(x, color=color, lw=0.9, ls="--")
+    ax_m.legend(fontsize=7, loc="lower left")
+    ax_m.set_xlim(max(f[keep].min(), 0.05), f.max())
+    ax_m.set_ylabel("|L| [dB]")
+    ax_p.set_ylabel("phase of L + 180 [deg]")
+    ax_p.set_yticks([-180, -90, 0, 90, 180])
+    ax_p.set_xlabel("frequency [Hz]")
+    for ax in (ax_m, ax_p):
+        ax.grid(True, which="both", alpha=0.3)
+    status = "meets" if not ch.violations(req) else "MISSES"
+    fig.suptitle(
+        (title + "\n" if title else "")
+        + f"loop broken at {control}, V = {margins.speed:.4g} m/s"
+        + (", one-sample delay" if margins.delay else "")
+        + f": {status} the requirement",
+        fontsize=10,
+    )
+    return fig
+
+
+def plot_margin_sweep(sweep: MarginSweep, control: str | None = None, title: str | None = None):
+    """Gain (both ways), phase and disk margins of one channel versus airspeed, with the
+    requirement; speeds where the loop is unstable are shaded."""
+    control = control or sweep.controls[0]
+    t = sweep.table(control)
+    req = sweep.requirement
+    v = sweep.speeds
+    fig = _figure(figsize=(7.5, 7.0))
+    ax_g, ax_p, ax_d = fig.subplots(3, 1, sharex=True)
+
+    def finite(a, cap):
+        return np.where(np.isinf(a), np.sign(a) * cap, a)
+
+    ax_g.plot(v, finite(t["gain_margin_db"], 40), "o-", ms=3, label="gain increase")
+    ax_g.plot(v, finite(t["gain_reduction_margin_db"], 40), "s-", ms=3, label="gain reduction")
+    for s in (1, -1):
+        ax_g.axhline(s * req.gain_db, color="tab:orange", ls="--", lw=1)
+    ax_g.set_ylabel("gain margin [dB]")
+    ax_g.set_ylim(-40, 40)
+    ax_g.legend(fontsize=7)
+    ax_p.plot(v, finite(t["phase_margin_deg"], 180), "o-", ms=3)
+    ax_p.axhline(req.phase_deg, color="tab:orange", ls="--", lw=1, label="requirement")
+    ax_p.set_ylabel("phase margin [deg]")
+    ax_p.set_ylim(0, 180)
+    ax_p.legend(fontsize=7)
+    ax_d.plot(v, t["disk_margin"], "o-", ms=3)
+    if req.disk_alpha is not None:
+        ax_d.axhline(req.disk_alpha, color="tab:orange", ls="--", lw=1)
+    ax_d.set_ylabel("disk margin alpha [-]")
+    ax_d.set_xlabel("airspeed V [m/s]")
+    for ax in (ax_g, ax_p, ax_d):
+        ax.grid(True, alpha=0.3)
+        for i in np.flatnonzero(~t["stable"]):
+            lo = v[max(i - 1, 0)] if i else v[0]
+            hi = v[min(i + 1, v.size - 1)]
+            ax.axvspan(0.5 * (lo + v[i]), 0.5 * (hi + v[i]), color="0.85", lw=0)
+        if sweep.reference_speed is not None:
+            ax.axvline(sweep.reference_speed, color="g", ls="--", lw=1)
+    rng = sweep.meeting_range(control)
+    note = (
+        f"requirement met from {rng[0]:.4g} to {rng[1]:.4g} m/s"
+        if rng
+        else "requirement not met at the reference speed"
+    )
+    fig.suptitle(
+        (title + "\n" if title else "") + f"margins at {control} versus airspeed: {note}\n"
+        "(grey: closed loop unstable; green: design speed; infinite margins at the axis limits)",
+        fontsize=9,
+    )
+    return fig

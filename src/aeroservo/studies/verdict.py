@@ -1,0 +1,111 @@
+"""The verdict of a closed-loop simulation: from the eigenvalues of the sampled loop at the
+scenario's speed and the growth of every recorded signal, controls included.
+
+* The **loop**: the spectral radius ``rho`` of the transition matrix of the sampled loop
+  (:func:`aeroservo.design.closed_loop_matrix`, the loop the simulator marches, delay included;
+  an MPC as its unconstrained LQG); ``rho >= 1`` is an unstable loop, whatever a short
+  simulation shows.
+* The **signals**: the growth of a signal is the largest ``|y|`` over the last
+  :data:`TAIL` of the record divided by its largest value before; above :data:`GROWS` the
+  response is still growing at the end (a nonlinear loop, e.g. saturated, can diverge while
+  its linear part is stable).
+
+The verdict is ``"unstable"`` if either says so. The command line then exits with status 3
+(unless the scenario sets ``simulation.expect_unstable = true``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["signal_growth", "loop_verdict", "TAIL", "GROWS", "EXIT_UNSTABLE"]
+
+TAIL = 0.2
+"""Share of the record at the end whose peak is compared with the peak before it."""
+
+GROWS = 1.05
+"""A signal whose last peak exceeds its earlier peak by more than this factor grows."""
+
+EXIT_UNSTABLE = 3
+"""Exit status of ``aeroservo simulate`` when the loop is unstable (and not expected to be)."""
+
+
+def signal_growth(y: np.ndarray, tail: float = TAIL) -> float:
+    """Peak over the last ``tail`` of a record / peak before it (NaN for a zero signal)."""
+    y = np.abs(np.asarray(y, dtype=float))
+    n = max(1, int(round(tail * y.size)))
+    before = y[:-n].max() if y.size > n else 0.0
+    if before == 0.0:
+        return float("nan") if y.max() == 0.0 else float("inf")
+    return float(y[-n:].max() / before)
+
+
+_REMEDIES = {
+    "open": "no controller acts: the open loop is unstable at this speed",
+    "state": "try smaller gains (larger input weights), a higher sample rate or, with a delay, "
+    "a design that accounts for it",
+    "estimator": "try more design modes (model.design_modes), slower sensor filters "
+    "(signals.sensor_filter) or a lower estimator gain (larger estimator.sensor_noise)",
+    "compensator": "try more design modes (model.design_modes), a lower bandwidth "
+    "(weights.bandwidth) or slower sensor filters (signals.sensor_filter)",
+}
+
+
+def loop_verdict(
+    plant, controller, delay: bool, signals: dict, limited: dict | None = None
+) -> dict:
+    """Verdict, spectral radius and the growing signals of a closed-loop run.
+
+    Parameters
+    ----------
+    plant : control.StateSpace
+        The plant at the scenario's speed (filters included).
+    controller
+        The sampled controller (a schedule evaluated at the speed).
+    delay : bool
+        Computational delay of the run.
+    signals : dict
+        ``{name: {"growth": ...}}`` of the recorded outputs and applied controls.
+    limited : dict, optional
+        ``{control: share of samples at a magnitude or rate limit}``, quoted in the hint.
+
+    Returns
+    -------
+    dict
+        ``verdict`` ("stable" or "unstable"), ``spectral_radius``, ``growth_rate`` [1/s] and
+        ``critical_frequency`` [Hz] of its largest eigenvalue, ``growing_signals`` and, when
+        unstable, a one-line ``hint``.
+    """
+    from ..design.closed_loop import closed_loop_matrix
+    from ..design.sampled_loop import linear_law
+
+    A, dt = closed_loop_matrix(plant, controller, delay=delay)
+    lam = np.linalg.eigvals(A)
+    i = int(np.argmax(np.abs(lam)))
+    rho = float(np.abs(lam[i]))
+    s = np.log(complex(lam[i])) / dt
+    growing = sorted(n for n, v in signals.items() if np.nan_to_num(v["growth"]) > GROWS)
+    unstable = rho > 1.0 + 1e-12 or bool(growing)
+    out = {
+        "verdict": "unstable" if unstable else "stable",
+        "spectral_radius": rho,
+        "growth_rate": float(np.log(rho) / dt),
+        "critical_frequency": float(abs(s.imag) / (2 * np.pi)),
+        "growing_signals": growing,
+    }
+    if unstable:
+        why = (
+            f"spectral radius {rho:.6g} of the sampled loop (growth rate "
+            f"{out['growth_rate']:.3g} 1/s at {out['critical_frequency']:.4g} Hz)"
+            if rho > 1.0 + 1e-12
+            else f"the loop's spectral radius is {rho:.6g}, but {', '.join(growing)} still grow"
+        )
+        law = linear_law(controller, plant.nstates)
+        kind = "open" if law.kind == "state" and not np.any(law.G) else law.kind
+        hint = f"closed loop unstable: {why}; {_REMEDIES[kind]}"
+        busy = {k: v for k, v in (limited or {}).items() if v >= 0.5}
+        if busy:
+            share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in busy.items())
+            hint += f" (at its limits: {share} of the samples; the limits bound the response)"
+        out["hint"] = hint
+    return out
