@@ -18,3 +18,42 @@ def test_root_locus_and_modes(goland10, goland10_flutter):
     assert plot_root_locus(goland10_flutter).axes
     fig = plot_mode_shapes(goland10, goland10.natural_modes(3), n=3)
     assert "1st bending" in fig.axes[0].get_title()
+
+
+def test_margin_figures(tmp_path):
+    """Nyquist/Bode and margin-sweep figures of the shipped LQR loop: labelled axes with units,
+    the margins' frequencies marked, the requirement drawn, files written."""
+    from conftest import ROOT
+
+    from aeroservo.design.margin_sweep import margins_over_speed
+    from aeroservo.design.margins import loop_margins
+    from aeroservo.files import load_scenario
+    from aeroservo.plots import plot_loop_margins, plot_margin_sweep
+    from aeroservo.stability.boundary import flutter_boundary
+
+    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
+    model = sc.model()
+    vf = flutter_boundary(model, sc.density).flutter_speed
+    loop = sc.loop(model)
+    ctrl = loop.design_controller(sc.controller, 1.1 * vf, sc.sample_rate, vf)
+    m = loop_margins(loop.plant(1.1 * vf), ctrl)
+    fig = plot_loop_margins(m, title=sc.name)
+    ax_n, ax_m, ax_p = fig.axes[:3]
+    assert ax_n.get_xlabel() == "Re L" and ax_m.get_ylabel() == "|L| [dB]"
+    assert ax_p.get_xlabel() == "frequency [Hz]"
+    labels = [t.get_text() for t in ax_m.get_legend().get_texts()]
+    assert any("phase 62" in t for t in labels) and any("gain reduction" in t for t in labels)
+    assert "requirement: 6 dB, 45 deg" in [t.get_text() for t in ax_n.get_legend().get_texts()]
+    fig.savefig(tmp_path / "m.png")
+    sw = margins_over_speed(
+        loop.plant, ctrl, [1.0 * vf, 1.1 * vf, 1.2 * vf], reference_speed=1.1 * vf
+    )
+    fig = plot_margin_sweep(sw)
+    assert [a.get_ylabel() for a in fig.axes] == [
+        "gain margin [dB]",
+        "phase margin [deg]",
+        "disk margin alpha [-]",
+    ]
+    assert fig.axes[-1].get_xlabel() == "airspeed V [m/s]"
+    fig.savefig(tmp_path / "s.png")
+    assert (tmp_path / "m.png").stat().st_size > 10_000 and (tmp_path / "s.png").is_file()

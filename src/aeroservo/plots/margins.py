@@ -109,7 +109,7 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
         if x:
             ax_m.axvline(x, color=color, lw=0.9, ls="--", label=f"{lab} at {x:.3g} Hz")
             ax_p.axvline(x, color=color, lw=0.9, ls="--")
-    ax_m.legend(fontsize=7, loc="lower left")
+    ax_m.legend(fontsize=7, loc="upper right")
     ax_m.set_xlim(max(f[keep].min(), 0.05), f.max())
     ax_m.set_ylabel("|L| [dB]")
     ax_p.set_ylabel("phase of L + 180 [deg]")

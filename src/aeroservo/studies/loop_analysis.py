@@ -83,8 +83,8 @@ def analyse_loop(
     finally:
         close()
     if scenario.margin_speeds:
-        v = res.boundary.speeds
-        speeds = np.unique(np.r_[np.linspace(v[0], v[-1], scenario.margin_speeds), speed])
+        speeds = _sweep_speeds(res.boundary, speed, scenario.margin_speeds)
+
         update, close = bar(v_top, "margin sweep")
         try:
             res.sweep = margins_over_speed(
@@ -99,3 +99,15 @@ def analyse_loop(
         finally:
             close()
     return res
+
+
+def _sweep_speeds(boundary, speed: float, n: int) -> np.ndarray:
+    """``n`` speeds [m/s] across the stable interval that holds ``speed`` (1 % inside its ends,
+    where the margins vanish), plus ``speed``; the whole range if no interval holds it."""
+    lo, hi = boundary.speeds[0], boundary.speeds[-1]
+    for a, b in boundary.stable_intervals():
+        if a <= speed <= b:
+            pad = 0.01 * (b - a)
+            lo, hi = a + pad, b - pad
+            break
+    return np.unique(np.r_[np.linspace(lo, hi, n), speed])
