@@ -111,3 +111,26 @@ def test_console_script_runs():
     out = json.loads(proc.stdout)
     assert out["wing"] == aes.examples.goland_aileron().name
     assert 130 < out["flutter_speed"] < 145
+
+
+def test_help_and_import_load_no_numerics():
+    """``import aeroservo`` and ``aeroservo --help`` import neither numpy nor scipy (the public
+    names load on first use): the help answers in a tenth of a second."""
+    code = (
+        "import sys, contextlib, io\n"
+        "import aeroservo, aeroservo.cli\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    try:\n"
+        "        aeroservo.cli.main(['--help'])\n"
+        "    except SystemExit:\n"
+        "        pass\n"
+        "heavy = [m for m in ('numpy', 'scipy', 'matplotlib', 'control', 'casadi')\n"
+        "         if m in sys.modules]\n"
+        "print(heavy)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert proc.stdout.strip() == "[]"
+    assert aes.flutter_boundary is aes.stability.boundary.flutter_boundary
+    assert "flutter_boundary" in dir(aes)
+    with pytest.raises(AttributeError, match="no attribute 'nonexistent'"):
+        aes.nonexistent  # noqa: B018

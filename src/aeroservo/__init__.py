@@ -1,39 +1,63 @@
-"""aeroservo: time-domain aero-servo-elastic analysis of wings with control surfaces."""
+"""aeroservo: time-domain aero-servo-elastic analysis of wings with control surfaces.
+
+The public names below are imported on first use (PEP 562), so ``import aeroservo`` and the
+command line load only what a task needs (``aeroservo --help`` does not import scipy).
+"""
+
+from __future__ import annotations
+
+import importlib
 
 from ._version import __version__
-from .aero.indicial import KUSSNER_SETS, WAGNER_SETS, IndicialSet
 from .errors import InputError
-from .linear.models import statespace, statespace_family
-from .linear.signals import Sensor
-from .linear.state_space import Servo, StateSpaceBuilder
-from .stability.boundary import flutter_boundary
-from .stability.divergence import divergence_speed
-from .stability.result import FlutterResult
-from .stability.sweep import eigen_sweep
-from .structure import examples
-from .structure.wing import Actuator, ControlSurface, Segment, Wing
-from .system.aeroelastic import AeroelasticModel, NaturalModes
 
-__all__ = [
-    "__version__",
-    "AeroelasticModel",
-    "Actuator",
-    "ControlSurface",
-    "FlutterResult",
-    "IndicialSet",
-    "InputError",
-    "KUSSNER_SETS",
-    "NaturalModes",
-    "Segment",
-    "Sensor",
-    "Servo",
-    "StateSpaceBuilder",
-    "WAGNER_SETS",
-    "Wing",
-    "divergence_speed",
-    "eigen_sweep",
-    "examples",
-    "flutter_boundary",
-    "statespace",
-    "statespace_family",
-]
+_PUBLIC = {
+    "AeroelasticModel": "system.aeroelastic",
+    "Actuator": "structure.wing",
+    "ControlSurface": "structure.wing",
+    "FlutterResult": "stability.result",
+    "IndicialSet": "aero.indicial",
+    "KUSSNER_SETS": "aero.indicial",
+    "NaturalModes": "system.aeroelastic",
+    "Segment": "structure.wing",
+    "Sensor": "linear.signals",
+    "Servo": "linear.state_space",
+    "StateSpaceBuilder": "linear.state_space",
+    "WAGNER_SETS": "aero.indicial",
+    "Wing": "structure.wing",
+    "divergence_speed": "stability.divergence",
+    "eigen_sweep": "stability.sweep",
+    "flutter_boundary": "stability.boundary",
+    "statespace": "linear.models",
+    "statespace_family": "linear.models",
+}
+_SUBPACKAGES = {
+    "examples": "structure.examples",
+    "aero": "aero",
+    "design": "design",
+    "files": "files",
+    "linear": "linear",
+    "plots": "plots",
+    "simulate": "simulate",
+    "stability": "stability",
+    "structure": "structure",
+    "studies": "studies",
+    "system": "system",
+}
+
+__all__ = ["__version__", "InputError", "examples", *sorted(_PUBLIC)]
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        value = getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+    elif name in _SUBPACKAGES:
+        value = importlib.import_module(f".{_SUBPACKAGES[name]}", __name__)
+    else:
+        raise AttributeError(f"module 'aeroservo' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_PUBLIC) | set(_SUBPACKAGES))
