@@ -130,9 +130,9 @@ def margins_over_speed(
     req = requirement or MarginRequirement()
     v = np.asarray(speeds, dtype=float)
     out: list[LoopMargins] = []
-    for s in v:
-        ctrl = controller.at(float(s)) if hasattr(controller, "at") else controller
-        out.append(loop_margins(at(float(s)), ctrl, delay=delay, requirement=req))
+    for s in v:  # loop_margins evaluates a schedule at the plant's speed
+        out.append(loop_margins(at(float(s)), controller, delay=delay, requirement=req))
+
         if progress is not None:
             progress(float(s))
     ref = (

@@ -45,6 +45,7 @@ class LoopAnalysis:
 def analyse_loop(
     scenario: Scenario,
     loop,
+    plant,
     controller,
     speed: float,
     flutter_speed: float | None,
@@ -52,7 +53,8 @@ def analyse_loop(
 ) -> LoopAnalysis:
     """Margins at ``speed`` [m/s]; boundary and margin sweep if the scenario asks.
 
-    ``bar(total, label)`` returns ``(update, close)`` of a progress bar.
+    ``plant`` is ``loop.plant(speed)``, the plant the run simulated; ``bar(total, label)``
+    returns ``(update, close)`` of a progress bar.
     """
     from ..design.closed_loop import closed_loop_boundary
     from ..design.margin_sweep import margins_over_speed
@@ -62,10 +64,8 @@ def analyse_loop(
     res = LoopAnalysis()
     if spec.type == "none":
         return res
-    at = controller.at(speed) if hasattr(controller, "at") else controller
-    res.margins = loop_margins(
-        loop.plant(speed), at, delay=scenario.delay, requirement=spec.margins
-    )
+    res.margins = loop_margins(plant, controller, delay=scenario.delay, requirement=spec.margins)
+
     if not (scenario.closed_loop_boundary and spec.type in LINEAR_TYPES):
         return res
     v_top = scenario.v_max_factor * (flutter_speed or speed)

@@ -227,6 +227,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     analysis = analyse_loop(
         scenario,
         loop,
+        plant,
         controller,
         speed,
         vf,
