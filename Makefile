@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install demo test lint bench clean
+.PHONY: install demo test lint bench bench-quick clean
 
 install: $(STAMP)
 
@@ -14,6 +14,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	$(BIN)/python -m compileall -q src
 	touch $(STAMP)
 
 demo: install
@@ -30,13 +31,23 @@ lint: install
 test: lint
 	$(BIN)/python -m pytest
 
+# every target of the performance issues with its ratio to a same-run baseline and PASS/FAIL
 bench: install
+	$(BIN)/python bench/bench_startup.py
 	$(BIN)/python bench/bench_flutter.py
 	$(BIN)/python bench/bench_statespace.py
 	$(BIN)/python bench/bench_control.py
 	$(BIN)/python bench/bench_mpc.py
 	$(BIN)/python bench/bench_mpc_step.py
 	$(BIN)/python bench/bench_trade.py
+
+# a few minutes: the issue-17 targets with fewer repeats (CI runs it as a smoke test that
+# reports and does not gate on timing: tests/test_bench.py)
+bench-quick: install
+	$(BIN)/python bench/bench_startup.py --quick
+	$(BIN)/python bench/bench_flutter.py --quick
+	$(BIN)/python bench/bench_mpc_step.py --quick
+	$(BIN)/python bench/bench_trade.py --quick
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .ruff_cache

@@ -22,6 +22,7 @@ BASE = (
     "aeroservo._version",
     "aeroservo.atomic",
     "aeroservo._c_stdout",
+    "aeroservo._lazy",
 )
 ORDER = [
     "base",
@@ -170,3 +171,20 @@ def test_the_checker_sees_a_cycle_and_an_upward_import():
 def test_module_size(mod):
     n = len(MODULES[mod].read_text(encoding="utf-8").splitlines())
     assert n <= MAX_LINES, f"{MODULES[mod]}: {n} lines; split it by job (limit {MAX_LINES})"
+
+
+def test_lazy_packages_have_no_name_shadowed_by_a_module():
+    """A lazily exported name equal to a submodule's name would resolve to the module once the
+    submodule is imported (PEP 562 ``__getattr__`` is then never called)."""
+    import importlib
+
+    for mod in MODULES:
+        path = MODULES[mod]
+        if path.name != "__init__.py" or "lazy_attributes" not in path.read_text():
+            continue
+        pkg = importlib.import_module(mod)
+        submodules = {p.stem for p in path.parent.glob("*.py")} | {
+            p.name for p in path.parent.iterdir() if (p / "__init__.py").exists()
+        }
+        clash = set(getattr(pkg, "_PUBLIC", {})) & submodules
+        assert not clash, f"{mod}: lazy names shadowed by modules {sorted(clash)}"

@@ -113,6 +113,104 @@ def test_console_script_runs():
     assert 130 < out["flutter_speed"] < 145
 
 
+_RUN_AND_LIST_MODULES = (
+    "import sys, contextlib, io\n"
+    "from aeroservo.cli import main\n"
+    "with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):\n"
+    "    code = main(sys.argv[1:])\n"
+    "print(code)\n"
+    "print(' '.join(sorted(sys.modules)))\n"
+)
+
+#: What ``aeroservo flutter goland --json`` may import (issue 17): numpy, scipy.linalg and
+#: scipy.sparse, and these aeroservo modules. A new top-level import that drags another
+#: module into the flutter path fails here; add it only if the flutter path needs it.
+FLUTTER_MODULES = {
+    "aeroservo",
+    "aeroservo._lazy",
+    "aeroservo._threads",
+    "aeroservo._version",
+    "aeroservo.errors",
+    *(f"aeroservo.aero{m}" for m in ("", ".atmosphere", ".indicial", ".theodorsen")),
+    *(f"aeroservo.cli{m}" for m in ("", ".analysis", ".options", ".results", ".scenarios")),
+    *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".wing_file")),
+    *(
+        f"aeroservo.stability{m}"
+        for m in (
+            "",
+            ".assignment",
+            ".boundary",
+            ".branches",
+            ".brent",
+            ".certificate",
+            ".crossings",
+            ".divergence",
+            ".matched",
+            ".modal",
+            ".result",
+            ".tracking",
+        )
+    ),
+    *(f"aeroservo.structure{m}" for m in ("", ".beam_element", ".examples", ".mesh", ".wing")),
+    *(
+        f"aeroservo.system{m}"
+        for m in ("", ".aeroelastic", ".assembly", ".damping", ".first_order", ".matrices")
+    ),
+}
+HEAVY = (
+    "matplotlib",
+    "control",
+    "casadi",
+    "dask",
+    "distributed",
+    "xarray",
+    "pandas",
+    "tqdm",
+    "scipy.optimize",
+    "scipy.special",
+    "scipy.signal",
+    "scipy.integrate",
+    "scipy.interpolate",
+    "scipy.io",
+)
+
+
+def _modules_of(*argv: str) -> tuple[int, set]:
+    proc = subprocess.run(
+        [sys.executable, "-c", _RUN_AND_LIST_MODULES, *argv],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    code, mods = proc.stdout.strip().splitlines()
+    return int(code), set(mods.split())
+
+
+def test_flutter_command_imports_only_what_it_needs():
+    """The set of modules ``aeroservo flutter goland --json`` imports is pinned."""
+    code, mods = _modules_of("flutter", "goland", "--json")
+    assert code == 0
+    assert {m for m in mods if m.startswith("aeroservo")} == FLUTTER_MODULES
+    assert [m for m in HEAVY if m in mods] == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ("flutter", "no_such_wing.toml"),
+        ("flutter", "goland", "--density", "-1"),
+        ("flutter", "goland", "--plot", "v.xyz"),
+        ("envelope", "goland"),  # --altitudes missing
+    ],
+)
+def test_input_errors_answer_before_numpy(argv):
+    """A missing file, a bad option or an unknown figure format is reported (exit 2) before
+    numpy is imported."""
+    code, mods = _modules_of(*argv)
+    assert code == 2
+    assert "numpy" not in mods
+
+
 def test_help_and_import_load_no_numerics():
     """``import aeroservo`` and ``aeroservo --help`` import neither numpy nor scipy (the public
     names load on first use): the help answers in a tenth of a second."""

@@ -18,6 +18,23 @@ def test_theodorsen_function_table():
     np.testing.assert_allclose(c.imag, exp["G"], atol=tol)
 
 
+@pytest.mark.parametrize(
+    "lo,hi", [(1e-9, 1e-3), (1e-3, 1.0), (1.0, 12.0), (12.0, 14.0), (14.0, 1e5)]
+)
+def test_theodorsen_function_against_scipy_hankel(lo, hi):
+    """The numpy Hankel series and asymptotic expansion against scipy.special.hankel2 (AMOS),
+    on random reduced frequencies in each range, the series/asymptotic switch included."""
+    from scipy.special import hankel2
+
+    rng = np.random.default_rng(int(hi * 1000) % 2**31)
+    k = np.exp(rng.uniform(np.log(lo), np.log(hi), 4000))
+    h1, h0 = hankel2(1, k), hankel2(0, k)
+    exact = h1 / (h1 + 1j * h0)
+    c = theodorsen_function(k)
+    # the power series of Y0, Y1 loses digits as e^k / k near the switch: 2e-11 is that bound
+    assert np.max(np.abs(c - exact) / np.abs(exact)) < 5e-11
+
+
 def test_theodorsen_limits():
     assert theodorsen_function(0.0) == 1.0
     assert abs(theodorsen_function(1e4) - 0.5) < 1e-4  # C -> 1/2 at high frequency

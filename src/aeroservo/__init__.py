@@ -6,8 +6,7 @@ command line load only what a task needs (``aeroservo --help`` does not import s
 
 from __future__ import annotations
 
-import importlib
-
+from ._lazy import lazy_attributes
 from ._version import __version__
 from .errors import InputError
 
@@ -28,6 +27,8 @@ _PUBLIC = {
     "divergence_speed": "stability.divergence",
     "eigen_sweep": "stability.sweep",
     "flutter_boundary": "stability.boundary",
+    "load_result": "files.results",
+    "save_result": "files.results",
     "statespace": "linear.models",
     "statespace_family": "linear.models",
 }
@@ -48,16 +49,4 @@ _SUBPACKAGES = {
 __all__ = ["__version__", "InputError", "examples", *sorted(_PUBLIC)]
 
 
-def __getattr__(name: str):
-    if name in _PUBLIC:
-        value = getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
-    elif name in _SUBPACKAGES:
-        value = importlib.import_module(f".{_SUBPACKAGES[name]}", __name__)
-    else:
-        raise AttributeError(f"module 'aeroservo' has no attribute {name!r}")
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_PUBLIC) | set(_SUBPACKAGES))
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC, _SUBPACKAGES)

@@ -3,9 +3,20 @@ flap (:mod:`.theodorsen`), Wagner and Kussner indicial functions (:mod:`.indicia
 velocity fields (:mod:`.gusts`).
 """
 
-from .gusts import GustSeries, OneMinusCosine, Turbulence
-from .indicial import KUSSNER_SETS, WAGNER_SETS, IndicialSet, kussner_set, wagner_set
-from .theodorsen import section_aero, theodorsen_function
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "GustSeries": "gusts",
+    "IndicialSet": "indicial",
+    "KUSSNER_SETS": "indicial",
+    "OneMinusCosine": "gusts",
+    "Turbulence": "gusts",
+    "WAGNER_SETS": "indicial",
+    "kussner_set": "indicial",
+    "section_aero": "theodorsen",
+    "theodorsen_function": "theodorsen",
+    "wagner_set": "indicial",
+}
 
 __all__ = [
     "GustSeries",
@@ -19,3 +30,5 @@ __all__ = [
     "theodorsen_function",
     "wagner_set",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

@@ -25,8 +25,70 @@ import numpy as np
 __all__ = ["theodorsen_function", "t_functions", "SectionAero", "section_aero"]
 
 
+#: Below this reduced frequency the Hankel functions come from their power series, above it
+#: from their asymptotic expansion; C(k) is then good to 2e-11 relative (tests/test_theodorsen.py
+#: compares with scipy.special.hankel2).
+SERIES_LIMIT = 13.0
+_EULER_GAMMA = 0.5772156649015329
+
+
+def _hankel_ratio_series(x: np.ndarray) -> np.ndarray:
+    """H1(2)(x) / H0(2)(x) from the power series of J0, J1, Y0, Y1 (A&S 9.1.10-11), x > 0."""
+    half = float(np.max(x)) / 2
+    n_terms, t = 1, 1.0  # terms until (x/2)^2m / m!^2 is below 1e-17 past its peak
+    while n_terms < 200 and (n_terms <= half or t > 1e-17):
+        t *= half * half / (n_terms * n_terms)
+        n_terms += 1
+    q = -((x / 2) ** 2)
+    t = np.ones_like(x)  # (-x^2/4)^m / m!^2
+    j0, j1 = np.zeros_like(x), np.zeros_like(x)
+    s0 = np.zeros_like(x)  # sum (-1)^(m+1) H_m (x/2)^2m / m!^2
+    s1 = np.zeros_like(x)  # sum (-1)^m (psi(m+1) + psi(m+2)) (x/2)^(2m+1) / (m! (m+1)!)
+    harmonic = 0.0
+    for m in range(n_terms):
+        if m:
+            t = t * (q / (m * m))
+            harmonic += 1.0 / m
+        u = t * (x / (2 * (m + 1)))  # (-1)^m (x/2)^(2m+1) / (m! (m+1)!)
+        j0 += t
+        j1 += u
+        s0 -= harmonic * t
+        s1 += (2 * harmonic + 1.0 / (m + 1) - 2 * _EULER_GAMMA) * u
+    log = np.log(x / 2)
+    y0 = (2 / np.pi) * ((log + _EULER_GAMMA) * j0 + s0)
+    y1 = (2 / np.pi) * log * j1 - 2 / (np.pi * x) - s1 / np.pi
+    return (j1 - 1j * y1) / (j0 - 1j * y0)
+
+
+def _hankel_ratio_asymptotic(x: np.ndarray) -> np.ndarray:
+    """H1(2)(x) / H0(2)(x) = i S1 / S0 from the Hankel expansions (A&S 9.2.7-8), x large:
+    S_nu = sum_k (-i)^k a_k(nu) / x^k, summed while the terms of the smallest x decrease."""
+    x_min = float(np.min(x))
+    inv = 1.0 / x
+    sums = []
+    for mu in (0.0, 4.0):  # 4 nu^2
+        coef, a = [1.0 + 0j], 1.0 + 0j
+        for k in range(1, 60):
+            nxt = a * (-1j) * (mu - (2 * k - 1) ** 2) / (8 * k)
+            if (
+                abs(nxt) / x_min**k >= abs(a) / x_min ** (k - 1)
+                or abs(a) / x_min ** (k - 1) < 1e-17
+            ):
+                break
+            a = nxt
+            coef.append(a)
+        total = np.full(x.shape, coef[-1])
+        for c in coef[-2::-1]:  # Horner in 1/x
+            total = total * inv + c
+        sums.append(total)
+    return 1j * sums[1] / sums[0]
+
+
 def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
     """Theodorsen's function C(k) = H1(2)(k) / (H1(2)(k) + i H0(2)(k)).
+
+    The Hankel functions are evaluated here with numpy (power series below
+    :data:`SERIES_LIMIT`, asymptotic expansion above), without ``scipy.special``.
 
     Parameters
     ----------
@@ -38,17 +100,17 @@ def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
     complex or ndarray of complex
         C(k) = F(k) + i G(k).
     """
-    from scipy.special import hankel2
-
     k_arr = np.asarray(k, dtype=float)
     if np.any(k_arr < 0) or not np.all(np.isfinite(k_arr)):
         raise ValueError(f"k = {k!r}: reduced frequency must be finite and >= 0")
     out = np.ones(k_arr.shape, dtype=complex)
-    pos = k_arr > 0
-    kp = k_arr[pos]
-    h1 = hankel2(1, kp)
-    h0 = hankel2(0, kp)
-    out[pos] = h1 / (h1 + 1j * h0)
+    for sel, ratio in (
+        ((k_arr > 0) & (k_arr < SERIES_LIMIT), _hankel_ratio_series),
+        (k_arr >= SERIES_LIMIT, _hankel_ratio_asymptotic),
+    ):
+        if np.any(sel):
+            r = ratio(k_arr[sel])
+            out[sel] = r / (r + 1j)
     return out if out.ndim else complex(out)
 
 

@@ -3,8 +3,9 @@
 Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure,
 3 a closed-loop simulation whose loop is unstable (unless the scenario expects it).
 Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
-need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``) and
-:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``plot``, ``examples``).
+need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``),
+:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``examples``) and :mod:`.results`
+(``plot``, ``export``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from collections.abc import Sequence
 
 from .._threads import blas_limited
 from ..errors import InputError
-from . import analysis, scenarios
+from . import analysis, results, scenarios
 
 __all__ = ["main"]
 
@@ -47,6 +48,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     analysis.add_parsers(sub)
     scenarios.add_parsers(sub)
+    results.add_parsers(sub)
     return p
 
 
@@ -88,7 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _UsageError as exc:
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2
-    handlers = {**analysis.HANDLERS, **scenarios.HANDLERS}
+    handlers = {**analysis.HANDLERS, **scenarios.HANDLERS, **results.HANDLERS}
     try:
         if getattr(args, "json", False):
             with _json_stdout():

@@ -37,6 +37,18 @@ def add_parsers(sub) -> None:
     )
     f.add_argument("--plot", metavar="FILE", help="write V-g and V-f diagrams (png, pdf, svg)")
     f.add_argument(
+        "--save",
+        metavar="FILE.npz",
+        help="save the sweep (eigenvalues, damping, modes, wing, flight condition) for "
+        "'aeroservo plot' and Python's aeroservo.load_result",
+    )
+    f.add_argument(
+        "--table",
+        metavar="FILE.csv",
+        help="write the sweep as an f06-like table: per mode and speed, damping g, frequency, "
+        "EAS and knots",
+    )
+    f.add_argument(
         "--g-required",
         type=positive_float,
         metavar="G",
@@ -81,6 +93,11 @@ def add_parsers(sub) -> None:
     m.add_argument("--elements", type=positive_int)
     m.add_argument("-n", type=positive_int, default=6, help="number of modes (default 6)")
     m.add_argument("--json", action="store_true")
+    m.add_argument("--plot", metavar="FILE", help="mode shapes figure (png, pdf, svg)")
+    m.add_argument("--mode", type=positive_int, metavar="N", help="only mode N (1-based)")
+    m.add_argument(
+        "--animate", metavar="FILE.gif", help="animation of mode N (default 1) at the tip"
+    )
 
 
 def _check_figure(path: str | None) -> None:
@@ -96,11 +113,35 @@ def _check_figure(path: str | None) -> None:
         raise InputError(f"--plot = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
 
 
+def _check_suffix(option: str, path: str | None, suffix: str) -> None:
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    if path is not None and Path(path).suffix.lower() != suffix:
+        raise InputError(f"{option} = {path!r}: expected a {suffix} file name")
+
+
+def _wing_text(spec: str, wing) -> str:
+    """The wing file text of a result: the file itself, or the wing written as one."""
+    from pathlib import Path
+
+    from ..files.toml_tables import is_scenario_file
+    from ..files.wing_file import wing_toml
+
+    p = Path(spec)
+    if p.suffix == ".toml" and p.is_file() and not is_scenario_file(p):
+        return p.read_text(encoding="utf-8-sig")
+    return wing_toml(wing)
+
+
 def _cmd_flutter(args: argparse.Namespace) -> int:
+    _check_figure(args.plot)
+    _check_suffix("--save", args.save, ".npz")
+    _check_suffix("--table", args.table, ".csv")
+    s = setup(args)
     from ..stability.boundary import flutter_boundary
 
-    _check_figure(args.plot)
-    s = setup(args)
     model, wing = s.model, s.wing
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
     n_modes = args.modes if args.modes is not None else s.opts.n_modes
@@ -143,14 +184,33 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
             "flutter_mach": pk.flutter_mach,
             "divergence_speed": pk.divergence_speed,
         }
+    title = f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
+    writers = []
     if args.plot:
-        from ..atomic import save_figure
+        from ..atomic import figure_writer
         from ..plots import plot_vg
 
-        title = f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
-        fig = plot_vg(result, title=title, g_required=args.g_required, units=args.units)
-        save_figure(fig, args.plot, dpi=150)
+        fig = plot_vg(result, title=title, g_required=args.g_required, units=args.units, pk=pk)
+        writers.append((args.plot, figure_writer(fig, args.plot, dpi=150)))
         out["plot"] = args.plot
+    if args.save:
+        from ..files.flutter_file import flutter_writer
+
+        text = _wing_text(args.wing, wing)
+        writers.append(
+            (args.save, flutter_writer(result, wing_text=text, model=model, pk=pk, title=title))
+        )
+        out["saved"] = args.save
+    if args.table:
+        from ..files.flutter_table import flutter_table
+
+        table = flutter_table(result, pk)
+        writers.append((args.table, lambda p: p.write_text(table, encoding="utf-8")))
+        out["table"] = args.table
+    if writers:
+        from ..atomic import atomic_write_set
+
+        atomic_write_set(writers)  # all the files, or none
     for w in result.warnings:
         print(f"aeroservo: warning: {w}", file=sys.stderr)
     if args.json:
@@ -164,8 +224,9 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         else:
             text = pk.speed_text(pk.flutter_speed, args.units)
             print(f"p-k (exact Theodorsen): flutter {text} at {pk.flutter_frequency:.5g} Hz")
-    if args.plot:
-        print(f"plot written to {args.plot}")
+    for key, what in (("plot", "plot"), ("saved", "sweep"), ("table", "table")):
+        if key in out:
+            print(f"{what} written to {out[key]}")
     return 0
 
 
@@ -249,12 +310,19 @@ def _envelope_text(env, units: str) -> str:
 
 
 def _cmd_modes(args: argparse.Namespace) -> int:
+    from ..errors import InputError
     from ..files.wing_file import resolve_wing
     from ..system.aeroelastic import AeroelasticModel
 
+    _check_figure(args.plot)
+    _check_suffix("--animate", args.animate, ".gif")
     wing, opts = resolve_wing(args.wing)
     model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
-    modes = model.natural_modes(min(args.n, model.n_dofs))
+    modes = model.natural_modes(min(max(args.n, args.mode or 1), model.n_dofs))
+    if args.mode is not None and args.mode > modes.frequencies.size:
+        raise InputError(f"--mode = {args.mode}: the model has {modes.frequencies.size} modes")
+    if args.plot or args.animate:
+        _mode_figures(args, model, modes)
     if args.json:
         print(
             json.dumps(
@@ -272,6 +340,42 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         for fr, lab in zip(modes.frequencies, modes.labels, strict=True):
             print(f"  {fr:10.4f} Hz  {lab}")
     return 0
+
+
+def _mode_figures(args: argparse.Namespace, model, modes) -> None:
+    """The ``--plot`` and ``--animate`` files of ``aeroservo modes`` (written as a set)."""
+    from ..atomic import atomic_write_set, figure_writer
+    from ..plots.modes import animate_mode, mode_fields, plot_modes
+
+    fields = mode_fields(model, modes.shapes)
+    cols = [args.mode - 1] if args.mode else list(range(modes.frequencies.size))
+    surfaces = {cs.name: (cs.start, cs.end) for cs in model.wing.control_surfaces}
+    writers = []
+    title = f"{model.wing.name}: {model.n_elements} elements, in-vacuo natural modes"
+    if args.plot:
+        fig = plot_modes(
+            fields, modes.labels, modes.frequencies, surfaces=surfaces, modes=cols, title=title
+        )
+        writers.append((args.plot, figure_writer(fig, args.plot, dpi=130)))
+    if args.animate:
+        j = (args.mode or 1) - 1
+        tip = model.wing.segments[-1]
+        cs = [c for c in model.wing.control_surfaces if c.end >= model.wing.span - 1e-9]
+        fig, anim = animate_mode(
+            fields,
+            j,
+            label=modes.labels[j],
+            frequency=float(modes.frequencies[j]),
+            semichord=tip.semichord,
+            elastic_axis=tip.a,
+            hinge=cs[0].hinge if cs else None,
+        )
+        from matplotlib.animation import PillowWriter
+
+        writers.append((args.animate, lambda p: anim.save(p, writer=PillowWriter(fps=20))))
+    atomic_write_set(writers)
+    for path, _ in writers:
+        print(f"written {path}", file=sys.stderr)
 
 
 HANDLERS = {"flutter": _cmd_flutter, "envelope": _cmd_envelope, "modes": _cmd_modes}

@@ -133,12 +133,16 @@ def _damping(args, default):
 def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
     """The wing, model and flight condition of an analysis command (file defaults, then the
     command-line options); ``altitudes``: the command sweeps altitudes itself."""
+    from ..files.toml_tables import read_toml
+
+    # a missing or malformed file is reported before numpy and scipy are imported
+    scenario = args.wing.endswith(".toml") and "scenario" in read_toml(args.wing)
+
     from ..aero.atmosphere import isa, isa_ft
-    from ..files.scenario_file import is_scenario_file
     from ..files.wing_file import AnalysisOptions, resolve_wing
     from ..system.aeroelastic import AeroelasticModel
 
-    if args.wing.endswith(".toml") and is_scenario_file(args.wing):
+    if scenario:
         from ..files.scenario_file import load_scenario
 
         sc = load_scenario(args.wing)  # a scenario: its wing, flight condition and options

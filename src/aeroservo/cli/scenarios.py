@@ -42,10 +42,6 @@ def add_parsers(sub) -> None:
                 "--workers", type=positive_int, help="LocalCluster workers (default: scenario)"
             )
 
-    pl = sub.add_parser("plot", help="re-plot a saved simulation result (.npz)")
-    pl.add_argument("result", help="result file written by 'aeroservo simulate'")
-    pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
-
     sub.add_parser("examples", help="list the built-in wings and the shipped scenarios")
 
 
@@ -215,23 +211,9 @@ def _readable(s: dict) -> str:
     return "\n".join(lines)
 
 
-def _cmd_plot(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from ..atomic import save_figure
-    from ..files.results import load_result
-
-    res = load_result(args.result)
-    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
-    save_figure(res.plot(), out, dpi=120)
-    print(f"plot written to {out}")
-    return 0
-
-
 HANDLERS = {
     "examples": _cmd_examples,
     "run": _cmd_run,
     "simulate": _cmd_run,
     "trade": _cmd_run,
-    "plot": _cmd_plot,
 }

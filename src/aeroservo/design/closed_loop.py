@@ -260,8 +260,9 @@ def closed_loop_boundary(
 
     Parameters
     ----------
-    plant_at : StateSpaceBuilder or callable
-        The plant at a speed: a builder (its ``at``) or ``V -> control.StateSpace`` (e.g. with
+    plant_at : ControlLoop, StateSpaceBuilder or callable
+        The plant at a speed: a :class:`~aeroservo.design.loop.ControlLoop` (its sampled
+        plants, cached), a builder (its ``at``) or ``V -> control.StateSpace`` (e.g. with
         sensor filters added).
     controller : StateFeedback, OutputFeedback or GainSchedule
         Linear controller; a schedule is evaluated at each speed.
@@ -295,7 +296,7 @@ def closed_loop_boundary(
     v_min = check_number("v_min", v_min, unit="m/s", lo=0.0, hi=v_max, lo_open=True, hi_open=True)
     n_grid = check_int("n_grid", n_grid, lo=3, hi=10_000)
     check_number("rtol", rtol, lo=0.0, hi=1e-2, lo_open=True)
-    at = plant_at.at if hasattr(plant_at, "at") else plant_at
+    at = getattr(plant_at, "at", None) or getattr(plant_at, "plant", None) or plant_at
     if reference_speed is None:
         reference_speed = getattr(controller, "design_speed", None)
         if reference_speed is None or not np.isfinite(reference_speed):
@@ -303,11 +304,16 @@ def closed_loop_boundary(
     reference_speed = check_number("reference_speed", reference_speed, unit="m/s", lo=0.0)
     n_eval = [0]
 
+    cached = getattr(plant_at, "sampled_plant", None) if sampled else None
+
     def evaluate(v: float) -> tuple[float, complex]:
         n_eval[0] += 1
-        A, dt = closed_loop_matrix(
-            at(v), _controller_at(controller, v), sampled=sampled, delay=delay
-        )
+        ctrl = _controller_at(controller, v)
+        if cached is not None:  # a ControlLoop: its sampled plants are reused across designs
+            law = linear_law(ctrl, plant_at.n_plant_states)
+            sp = cached(v, ctrl.dt, list(ctrl.controls), list(law.sensors))
+            return _measure(loop_matrix(sp, law, delay), ctrl.dt)
+        A, dt = closed_loop_matrix(at(v), ctrl, sampled=sampled, delay=delay)
         return _measure(A, dt)
 
     V = np.linspace(v_min, v_max, n_grid)

@@ -15,6 +15,7 @@ turns a :class:`~aeroservo.design.spec.ControllerSpec` into a controller at a de
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Sequence
 
 import numpy as np
@@ -26,9 +27,12 @@ from .hinf import hinf
 from .lqg import lqg
 from .lqr import Bryson, lqr
 from .mpc import mpc
-from .plant import OpenLoop, state_map, with_sensor_filters
+from .plant import OpenLoop, SampledPlant, state_map, with_sensor_filters
 from .schedule import GainSchedule, schedule
 from .spec import ControllerSpec
+
+SAMPLED_CACHE = 96
+"""Sampled plants kept per :class:`ControlLoop` (about 80 kB each for a 10-element wing)."""
 
 __all__ = ["ControlLoop", "check_spec_signals"]
 
@@ -96,6 +100,7 @@ class ControlLoop:
         self.sensor_filter = sensor_filter if self.filtered else None
         self.filter_order = filter_order
         self.T = state_map(self.plant_builder, self.design_builder)
+        self._sampled: OrderedDict = OrderedDict()
 
     @property
     def units(self) -> dict:
@@ -111,10 +116,37 @@ class ControlLoop:
         """Full plant at ``speed`` [m/s] (``control.StateSpace``, filters included)."""
         return self._filter(self.plant_builder.at(speed))
 
+    def sampled_plant(
+        self, speed: float, dt: float, controls: Sequence[str], outputs: Sequence[str]
+    ) -> SampledPlant:
+        """The full plant at ``speed`` [m/s] discretized with a zero-order hold of ``dt`` [s]
+        (:meth:`SampledPlant.from_statespace` of :meth:`plant`), restricted to ``controls``
+        and ``outputs``.
+
+        The last :data:`SAMPLED_CACHE` results are kept: a closed-loop boundary evaluates the
+        same grid speeds for every controller designed around this loop (the cases of a trade
+        study that differ only in controller weights), and the plant at a speed never changes.
+        """
+        key = (float(speed), float(dt), tuple(controls), tuple(outputs))
+        hit = self._sampled.get(key)
+        if hit is not None:
+            self._sampled.move_to_end(key)
+            return hit
+        sp = SampledPlant.from_statespace(self.plant(speed), dt, controls, (), outputs)
+        self._sampled[key] = sp
+        while len(self._sampled) > SAMPLED_CACHE:
+            self._sampled.popitem(last=False)
+        return sp
+
     def design(self, speed: float, filtered: bool = True):
         """Design model at ``speed`` [m/s] (truncated; filters included if ``filtered``)."""
         d = self.design_builder.at(speed)
         return self._filter(d) if filtered else d
+
+    @property
+    def n_plant_states(self) -> int:
+        """States of the full plant, sensor filters included."""
+        return self.plant_builder.n_states + self.n_filter_states
 
     @property
     def n_filter_states(self) -> int:

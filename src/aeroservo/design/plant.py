@@ -12,6 +12,7 @@ computational delay of one sample, ``u[k]`` is the command computed at ``k - 1``
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -239,6 +240,22 @@ class OpenLoop:
         pass
 
 
+@functools.lru_cache(maxsize=16)
+def _butterworth(order: int, cutoff: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A, B, C)`` of an analogue Butterworth low-pass of ``cutoff`` [Hz] (no feedthrough);
+    speed-independent, so built once per filter (read-only arrays)."""
+    import control
+    from scipy.signal import butter
+
+    num, den = butter(order, 2 * np.pi * cutoff, analog=True)
+    mats = tuple(
+        np.atleast_2d(np.asarray(x, dtype=float)) for x in control.ssdata(control.tf2ss(num, den))
+    )
+    for x in mats:
+        x.setflags(write=False)
+    return mats[:3]
+
+
 def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int = 2):
     """The continuous plant with analogue anti-aliasing filters on some outputs.
 
@@ -264,15 +281,11 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
         States ``<sensor>_filter<i>`` appended; metadata (speed, density, units) kept.
     """
     import control
-    from scipy.signal import butter
 
     fc = check_number("cutoff", cutoff, unit="Hz", lo=0.0, lo_open=True)
     if order not in (1, 2, 3, 4):
         raise InputError(f"order = {order!r}: allowed values are 1, 2, 3, 4")
-    num, den = butter(order, 2 * np.pi * fc, analog=True)
-    fa, fb, fc_, _ = (
-        np.atleast_2d(np.asarray(x, dtype=float)) for x in control.ssdata(control.tf2ss(num, den))
-    )
+    fa, fb, fc_ = _butterworth(order, fc)
     A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
     n, m = B.shape
     rows = _index(sys.output_labels, sensors, "sensor")

@@ -4,12 +4,19 @@ files (:mod:`.results`), the outputs of a run written as a set (:mod:`.outputs`)
 state-space exports (:mod:`.statespace_export`).
 """
 
-from .controller_file import load_controller
-from .outputs import write_run
-from .results import load_result, save_result
-from .scenario_file import load_scenario
-from .statespace_export import export_mat, export_npz
-from .wing_file import load_wing, resolve_wing
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "export_mat": "statespace_export",
+    "export_npz": "statespace_export",
+    "load_controller": "controller_file",
+    "load_result": "results",
+    "load_scenario": "scenario_file",
+    "load_wing": "wing_file",
+    "resolve_wing": "wing_file",
+    "save_result": "results",
+    "write_run": "outputs",
+}
 
 __all__ = [
     "export_mat",
@@ -22,3 +29,5 @@ __all__ = [
     "save_result",
     "write_run",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

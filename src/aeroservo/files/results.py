@@ -1,5 +1,6 @@
 """Result files: a simulation as one ``.npz`` (time histories and a JSON ``meta`` record with
-units, limits and the summary), read back for re-plotting. No pickled objects.
+units, limits and the summary) or a flutter sweep (:mod:`.flutter_file`), read back for
+re-plotting. No pickled objects.
 """
 
 from __future__ import annotations
@@ -51,42 +52,78 @@ def result_writer(result, summary: dict | None = None):
     return write
 
 
-def save_result(result, path: str | Path, summary: dict | None = None) -> Path:
-    """Write a simulation result to ``.npz`` (atomically)."""
+def save_result(result, path: str | Path, summary: dict | None = None, **kw) -> Path:
+    """Write a result to ``.npz`` (atomically): a simulation, or a flutter sweep.
+
+    Parameters
+    ----------
+    result : SimulationResult or FlutterResult
+    path : str or Path
+    summary : dict, optional
+        Summary stored with a simulation.
+    **kw
+        For a flutter sweep, :func:`aeroservo.files.flutter_file.flutter_writer`'s
+        ``wing_text``, ``model``, ``pk`` and ``title`` (``wing_text`` defaults to the model's
+        wing written as a wing file).
+    """
+    from ..stability.result import FlutterResult
+
+    if isinstance(result, FlutterResult):
+        from .flutter_file import flutter_writer
+        from .wing_file import wing_toml
+
+        model = kw.get("model")
+        if "wing_text" not in kw:
+            if model is None or not hasattr(model, "wing"):
+                raise InputError("save_result: give wing_text= or model= for a flutter result")
+            kw["wing_text"] = wing_toml(model.wing)
+        return atomic_write(path, flutter_writer(result, **kw))
+    if not hasattr(result, "outputs"):
+        raise InputError(
+            f"save_result: result = {type(result).__name__}: expected a SimulationResult or a "
+            "FlutterResult"
+        )
     return atomic_write(path, result_writer(result, summary))
 
 
 def load_result(path: str | Path):
-    """Read a result written by :func:`save_result` back into a ``SimulationResult``."""
+    """Read a result written by :func:`save_result`: a ``SimulationResult``, or a
+    :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep."""
+    from .flutter_file import FORMAT, open_npz, read_flutter
+
+    path = Path(path)
+    data, meta = open_npz(path)
+    fmt = meta.get("format")
+    if fmt == FORMAT:
+        return read_flutter(path, data, meta)
+    if fmt != "aeroservo-simulation-1":
+        raise InputError(f"{path}: not an aeroservo result (format {fmt!r})")
     from ..design.plant import Limits
     from ..simulate.result import SimulationResult
 
-    path = Path(path)
+    groups: dict = {"outputs": {}, "commands": {}, "applied": {}, "disturbance": {}}
+    for key, value in data.items():
+        if "." in key:
+            g, name = key.split(".", 1)
+            if g in groups:
+                groups[g][name] = value
+    t = data.get("t")
+    if t is None or t.ndim != 1 or t.dtype.kind != "f":
+        raise InputError(f"{path}: simulation result without a 1-D time array 't'")
+    for g, sig in groups.items():
+        for name, y in sig.items():
+            if y.dtype.kind not in "fiub" or y.shape[:1] != t.shape:
+                raise InputError(f"{path}: signal {g}.{name} does not match the {t.size} times")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            groups: dict = {"outputs": {}, "commands": {}, "applied": {}, "disturbance": {}}
-            for key in data.files:
-                if "." in key:
-                    g, name = key.split(".", 1)
-                    if g in groups:
-                        groups[g][name] = data[key]
-            t = data["t"]
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such result file") from None
-    except (OSError, ValueError, KeyError) as exc:
-        raise InputError(f"{path}: not an aeroservo simulation result ({exc})") from None
-    if meta.get("format") != "aeroservo-simulation-1":
-        raise InputError(
-            f"{path}: not an aeroservo simulation result (format {meta.get('format')})"
+        return SimulationResult(
+            t=t,
+            status=[],
+            limits=Limits(**meta["limits"]),
+            units=dict(meta["units"]),
+            speed=float(meta["speed"]),
+            density=float(meta["density"]),
+            summary=dict(meta.get("summary", {})),
+            **groups,
         )
-    return SimulationResult(
-        t=t,
-        status=[],
-        limits=Limits(**meta["limits"]),
-        units=meta["units"],
-        speed=meta["speed"],
-        density=meta["density"],
-        summary=meta.get("summary", {}),
-        **groups,
-    )
+    except (KeyError, TypeError, ValueError, InputError) as exc:
+        raise InputError(f"{path}: header of the simulation result is not valid ({exc})") from None

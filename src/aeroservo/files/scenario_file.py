@@ -17,7 +17,7 @@ from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .scenario_checks import cross_check
 from .scenario_tables import controller, disturbance, flight, is_file, trade_table
-from .toml_tables import Table, check_integers, one_line_errors, read_toml
+from .toml_tables import Table, check_integers, is_scenario_file, one_line_errors, read_toml
 from .wing_file import damping_from_dict
 
 __all__ = ["load_scenario", "scenario_from_dict", "is_scenario_file", "shipped_scenarios"]
@@ -234,14 +234,6 @@ def load_scenario(path: str | Path) -> Scenario:
     path = Path(path)
     with one_line_errors():
         return scenario_from_dict(read_toml(path), str(path), path.parent)
-
-
-def is_scenario_file(path: str | Path) -> bool:
-    """Whether a TOML file is a scenario (it has a ``[scenario]`` table)."""
-    try:
-        return "scenario" in read_toml(path)
-    except InputError:
-        return False
 
 
 def scenario_folder():

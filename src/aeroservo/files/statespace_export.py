@@ -1,6 +1,7 @@
 """State-space models written for MATLAB (``.mat``) and NumPy (``.npz``): A, B, C, D with the
-signal names and units, speed, density, sample time and the state scaling of a balanced
-realization (``x_physical = state_scaling .* x``).
+state and signal names and units, speed, density, sample time and the state scaling of a
+balanced realization (``x_physical = state_scaling .* x``). ``matlab/load_aeroservo.m`` builds
+a named ``ss`` from the ``.mat`` file.
 """
 
 from __future__ import annotations
@@ -14,6 +15,19 @@ from ..atomic import atomic_write
 __all__ = ["export_mat", "export_npz"]
 
 
+_STATE_UNITS = {"w": "m", "theta": "rad", "phi": "rad", "delta": "rad", "eta": "modal"}
+
+
+def state_unit(name: str) -> str:
+    """Unit of a state by its name: structural unknowns (``w_3`` m, ``theta_3``, ``phi_3``,
+    ``delta_<surface>_3`` rad, modal ``eta_2``) and their rates (``..._dot``, per s); aerodynamic
+    lag, gust and servo states have no physical unit here (empty)."""
+    rate = name.endswith("_dot")
+    base = name[: -len("_dot")] if rate else name
+    unit = _STATE_UNITS.get(base.split("_", 1)[0], "")
+    return f"{unit}/s" if unit and rate else unit
+
+
 def _export_dict(sys) -> dict:
     return {
         "A": np.asarray(sys.A),
@@ -21,6 +35,7 @@ def _export_dict(sys) -> dict:
         "C": np.asarray(sys.C),
         "D": np.asarray(sys.D),
         "state_names": np.array(sys.state_labels, dtype=object),
+        "state_units": np.array([state_unit(n) for n in sys.state_labels], dtype=object),
         "input_names": np.array(sys.input_labels, dtype=object),
         "output_names": np.array(sys.output_labels, dtype=object),
         "input_units": np.array(

@@ -295,3 +295,11 @@ class Table:
             self.fail(key, s, "expected a file path")
         p = Path(s)
         return p if p.is_absolute() else base / p
+
+
+def is_scenario_file(path: str | Path) -> bool:
+    """Whether a TOML file is a scenario (it has a ``[scenario]`` table)."""
+    try:
+        return "scenario" in read_toml(path)
+    except InputError:
+        return False

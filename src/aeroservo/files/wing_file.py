@@ -22,7 +22,14 @@ from ..stability.matched import COMPRESSIBILITY
 from ..structure.wing import Actuator, ControlSurface, Segment, Wing
 from ..system.damping import NO_DAMPING, StructuralDamping
 
-__all__ = ["AnalysisOptions", "load_wing", "wing_from_dict", "resolve_wing", "damping_from_dict"]
+__all__ = [
+    "AnalysisOptions",
+    "load_wing",
+    "wing_from_dict",
+    "wing_toml",
+    "resolve_wing",
+    "damping_from_dict",
+]
 
 SEGMENT_KEYS = ("start", "end", "semichord", "a", "mass", "x_alpha", "inertia", "EI", "GJ")
 SURFACE_REQUIRED = ("name", "start", "end", "hinge", "static_moment", "inertia")
@@ -250,3 +257,25 @@ def resolve_wing(spec: str | Path) -> tuple[Wing, AnalysisOptions]:
     raise InputError(
         f"wing = {str(spec)!r}: not a built-in wing {sorted(BUILTIN_WINGS)} nor a .toml file"
     )
+
+
+def wing_toml(wing: Wing) -> str:
+    """The ``[wing]`` table of a wing file describing ``wing`` (read back by :func:`load_wing`;
+    numbers written with ``repr``, so the round trip is exact)."""
+    import json
+
+    def num(x: float) -> str:
+        return repr(float(x))
+
+    lines = ["[wing]", f"name = {json.dumps(wing.name)}", f"span = {num(wing.span)}"]
+    for seg in wing.segments:
+        lines += ["", "[[wing.segments]]"]
+        lines += [f"{k} = {num(getattr(seg, k))}" for k in SEGMENT_KEYS]
+    for cs in wing.control_surfaces:
+        lines += ["", "[[wing.control_surfaces]]", f"name = {json.dumps(cs.name)}"]
+        keys = SURFACE_REQUIRED[1:] + ("GJ", "hinge_stiffness")
+        lines += [f"{k} = {num(getattr(cs, k))}" for k in keys]
+        for act in cs.actuators:
+            lines += ["", "[[wing.control_surfaces.actuators]]"]
+            lines += [f"{k} = {num(getattr(act, k))}" for k in ACTUATOR_KEYS]
+    return "\n".join(lines) + "\n"

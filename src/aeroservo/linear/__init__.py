@@ -3,10 +3,19 @@ state-space builder (:mod:`.state_space`), models at a flight condition or over 
 (:mod:`.models`) and model reduction (:mod:`.reduction`).
 """
 
-from .models import discretize, statespace, statespace_family
-from .reduction import balanced_truncation, compare_frequency_response, modal_controllability
-from .signals import Sensor
-from .state_space import Servo, StateSpaceBuilder
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "Sensor": "signals",
+    "Servo": "state_space",
+    "StateSpaceBuilder": "state_space",
+    "balanced_truncation": "reduction",
+    "compare_frequency_response": "reduction",
+    "discretize": "models",
+    "modal_controllability": "reduction",
+    "statespace": "models",
+    "statespace_family": "models",
+}
 
 __all__ = [
     "Sensor",
@@ -19,3 +28,5 @@ __all__ = [
     "statespace",
     "statespace_family",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

@@ -1,18 +1,32 @@
-"""Figures of single results: V-g / V-f diagrams, root loci, mode shapes, flutter envelopes
-(:mod:`.flutter`) and loop margins (:mod:`.margins`).
+"""Figures of single results: V-g / V-f diagrams, root loci, flutter envelopes (:mod:`.flutter`),
+mode shapes and their animation (:mod:`.modes`) and loop margins (:mod:`.margins`).
 
 Functions return :class:`matplotlib.figure.Figure` objects built without ``pyplot`` (no GUI
 backend needed; they display inline in notebooks and save with ``fig.savefig``).
 """
 
-from .flutter import plot_envelope, plot_mode_shapes, plot_root_locus, plot_vg
-from .margins import plot_loop_margins, plot_margin_sweep
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "plot_envelope": "flutter",
+    "plot_loop_margins": "margins",
+    "plot_margin_sweep": "margins",
+    "animate_mode": "modes",
+    "plot_mode_shapes": "modes",
+    "plot_modes": "modes",
+    "plot_root_locus": "flutter",
+    "plot_vg": "flutter",
+}
 
 __all__ = [
     "plot_vg",
     "plot_root_locus",
     "plot_mode_shapes",
+    "plot_modes",
+    "animate_mode",
     "plot_envelope",
     "plot_loop_margins",
     "plot_margin_sweep",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

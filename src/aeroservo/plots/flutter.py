@@ -6,6 +6,7 @@ backend needed; they display inline in notebooks and save with ``fig.savefig``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -14,9 +15,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from ..stability.result import FlutterResult
-    from ..system.aeroelastic import AeroelasticModel, NaturalModes
 
-__all__ = ["plot_vg", "plot_root_locus", "plot_mode_shapes", "plot_envelope"]
+__all__ = ["plot_vg", "plot_root_locus", "plot_envelope", "select_modes"]
 
 
 def _figure(**kw) -> Figure:
@@ -25,16 +25,50 @@ def _figure(**kw) -> Figure:
     return Figure(layout="constrained", **kw)
 
 
+def select_modes(
+    result: FlutterResult, fmax: float | None = None, modes: Sequence[int] | None = None
+) -> list[int]:
+    """Indices of the branches to draw: ``modes`` (1-based), or those whose frequency at the
+    start of the sweep is at most ``fmax`` [Hz], or all."""
+    n = len(result.mode_labels)
+    if modes is not None:
+        bad = [m for m in modes if not 1 <= int(m) <= n]
+        if bad:
+            from ..errors import InputError
+
+            raise InputError(f"modes = {list(modes)}: the sweep has modes 1 to {n}")
+        return [int(m) - 1 for m in modes]
+    if fmax is not None:
+        f0 = result.frequencies[0]
+        keep = [j for j in range(n) if not f0[j] > fmax]  # NaN kept
+        if result.flutter is not None and result.flutter.mode not in keep:
+            keep.append(result.flutter.mode)  # the flutter branch is always drawn
+        return sorted(keep)
+    return list(range(n))
+
+
+def _oscillatory(lam: np.ndarray) -> np.ndarray:
+    return np.isfinite(lam) & (np.abs(lam.imag) > 1e-7 * np.abs(lam))
+
+
 def plot_vg(
     result: FlutterResult,
     *,
     title: str | None = None,
     g_required: float | None = None,
     units: str = "si",
+    eas: bool = False,
+    fmax: float | None = None,
+    modes: Sequence[int] | None = None,
+    pk: FlutterResult | None = None,
 ) -> Figure:
     """V-f (top) and V-g (bottom) diagrams of the tracked modes, flutter point marked.
 
     ``g = -2 zeta`` (positive: unstable). Divergence, when inside the range, is a dashed line.
+    Where a branch is overdamped (a pair of real roots) it is drawn dotted at 0 Hz on the V-f
+    panel and left out of the V-g panel (its g is not a structural damping); the line is broken
+    there, so a branch that becomes oscillatory again is not joined to its earlier stretch.
+    The damping axis spans every drawn point; the legend sits outside the panels.
 
     Parameters
     ----------
@@ -46,32 +80,70 @@ def plot_vg(
         below. The branches are the total damping of the model (its structural damping
         included): apply the requirement to the undamped model's curves, as is usual.
     units : {"si", "knots"}
-        Speed axis in m/s or knots (TAS).
+        Speed axis in m/s or knots.
+    eas : bool
+        Equivalent instead of true airspeed on the speed axis.
+    fmax : float, optional
+        Draw only the modes whose frequency at the start of the sweep is at most ``fmax`` [Hz]
+        (the flutter mode is always drawn).
+    modes : sequence of int, optional
+        Draw only these modes (1-based, as in the table); overrides ``fmax``.
+    pk : FlutterResult, optional
+        A p-k sweep of the same wing, drawn as crosses (black: its flutter point).
     """
-    from ..aero.atmosphere import KNOT
+    from ..aero.atmosphere import KNOT, RHO0
 
-    scale = 1 / KNOT if units == "knots" else 1.0
-    fig = _figure(figsize=(7.0, 6.5))
+    if units not in ("si", "knots"):
+        from ..errors import InputError
+
+        raise InputError(f"units = {units!r}: allowed values are 'si', 'knots'")
+    scale = (1 / KNOT if units == "knots" else 1.0) * (
+        np.sqrt(result.density / RHO0) if eas else 1.0
+    )
+    fig = _figure(figsize=(8.2, 6.5))
     ax_f, ax_g = fig.subplots(2, 1, sharex=True)
     V = result.speeds * scale
     f = result.frequencies
     g = -2.0 * result.damping_ratio
-    for j, lab in enumerate(result.mode_labels):
-        (line,) = ax_f.plot(V, f[:, j], lw=1.4, label=lab)
-        ax_g.plot(V, g[:, j], lw=1.4, color=line.get_color())
+    drawn_g = [np.zeros(1)]
+    for j in select_modes(result, fmax, modes):
+        lam = result.eigenvalues[:, j]
+        osc = _oscillatory(lam)
+        lab = f"{j + 1}: {result.mode_labels[j]}"
+        (line,) = ax_f.plot(V, np.where(osc, f[:, j], np.nan), lw=1.4, label=lab)
+        ax_g.plot(V, np.where(osc, g[:, j], np.nan), lw=1.4, color=line.get_color())
+        real = np.isfinite(lam) & ~osc
+        if real.any():
+            ax_f.plot(V, np.where(real, 0.0, np.nan), ":", lw=2.0, color=line.get_color())
+        drawn_g.append(g[osc, j])
+    if pk is not None:
+        same = len(pk.mode_labels) == len(result.mode_labels)
+        drawn = select_modes(result, fmax, modes) if same else select_modes(pk, fmax, modes)
+        pk_osc = _oscillatory(pk.eigenvalues)
+        pk_osc[:, [j for j in range(pk_osc.shape[1]) if j not in drawn]] = False
+        Vp = np.broadcast_to(pk.speeds[:, None] * scale, pk.eigenvalues.shape)
+        gp = -2.0 * pk.damping_ratio
+        ax_f.plot(Vp[pk_osc], pk.frequencies[pk_osc], "x", color="0.35", ms=4, label="p-k")
+        ax_g.plot(Vp[pk_osc], gp[pk_osc], "x", color="0.35", ms=4)
+        drawn_g.append(gp[pk_osc])
+        if pk.flutter is not None:
+            fp = pk.flutter
+            ax_g.plot(fp.speed * scale, 0.0, "X", color="k", ms=8, label="p-k flutter")
+            ax_f.plot(fp.speed * scale, fp.frequency, "X", color="k", ms=8)
+    ax_f.plot([], [], ":", color="0.4", lw=2.0, label="overdamped (real roots)")
     ax_g.axhline(0.0, color="k", lw=0.8)
     if g_required is not None:
-        label = f"g = -{g_required:g} (required damping {g_required:g})"
+        label = f"g = -{g_required:g} (required damping)"
         ax_g.axhline(-g_required, color="r", lw=0.9, ls="--", label=label)
-        ax_g.legend(fontsize=8, loc="lower left")
     for c in result.crossings:
         marker = "o" if c.kind == "onset" else ("s" if c.kind == "recovery" else "D")
         mfc = "none" if c.kind != "onset" else "r"
         ax_g.plot(c.speed * scale, 0.0, marker, color="k", ms=6, mfc=mfc)
         ax_f.plot(c.speed * scale, c.frequency, marker, color="k", ms=6, mfc=mfc)
     fl = result.flutter
+    unit = ("kt" if units == "knots" else "m/s") + (" EAS" if eas else "")
     if fl is not None:
-        unit = "kt" if units == "knots" else "m/s"
+        ax_g.plot([], [], "o", color="k", mfc="r", label=f"flutter {fl.speed * scale:.4g} {unit}")
         ax_g.annotate(
             f"flutter {fl.speed * scale:.4g} {unit}\n{fl.frequency:.4g} Hz",
             (fl.speed * scale, 0.0),
@@ -88,15 +160,20 @@ def plot_vg(
         )
     ax_f.set_ylabel("frequency [Hz]")
     ax_g.set_ylabel(r"$g = -2\zeta$ [-]  (> 0 unstable)")
-    ax_g.set_xlabel("true airspeed V [kt]" if units == "knots" else "true airspeed V [m/s]")
-    ax_f.legend(fontsize=8, ncol=2)
+    speed = ("equivalent" if eas else "true") + " airspeed"
+    ax_g.set_xlabel(f"{speed} [{'kt' if units == 'knots' else 'm/s'}]")
     for ax in (ax_f, ax_g):
         ax.grid(True, alpha=0.3)
-    lo = min(np.nanmin(g), -(g_required or 0.0))
-    ax_g.set_ylim(max(lo, -1.0) * 1.05, max(0.1, np.nanmax(g) * 1.1))
+    gs = np.concatenate([d[np.isfinite(d)] for d in drawn_g] + [[-(g_required or 0.0)]])
+    lo, hi = float(gs.min()), float(gs.max())
+    pad = 0.06 * max(hi - lo, 1e-3)
+    ax_g.set_ylim(lo - pad, hi + pad)
+    ax_f.set_ylim(bottom=-0.02 * max(ax_f.get_ylim()[1], 1.0))
+    handles = [h for ax in (ax_f, ax_g) for h in ax.get_legend_handles_labels()[0]]
+    labels = [t for ax in (ax_f, ax_g) for t in ax.get_legend_handles_labels()[1]]
+    fig.legend(handles, labels, loc="outside right upper", fontsize=8)
     condition = result.condition_text().replace("; ", "\n", 1)
     fig.suptitle((title + "\n" if title else "V-g / V-f\n") + condition, fontsize=9)
-
     return fig
 
 
@@ -175,43 +252,40 @@ def plot_envelope(envelope, *, units: str = "si", x: str = "eas") -> Figure:
     return fig
 
 
-def plot_root_locus(result: FlutterResult, *, title: str | None = None) -> Figure:
-    """Tracked eigenvalues in the complex plane as speed increases (colour = speed)."""
+def plot_root_locus(
+    result: FlutterResult,
+    *,
+    title: str | None = None,
+    fmax: float | None = None,
+    modes: Sequence[int] | None = None,
+    units: str = "si",
+) -> Figure:
+    """Tracked eigenvalues in the complex plane as speed increases (colour = speed);
+    ``fmax``, ``modes`` and ``units`` as in :func:`plot_vg`."""
+    from ..aero.atmosphere import KNOT
+
+    scale = 1 / KNOT if units == "knots" else 1.0
     fig = _figure(figsize=(6.5, 5.0))
     ax = fig.subplots()
-    V = result.speeds
-    for j, lab in enumerate(result.mode_labels):
+    V = result.speeds * scale
+    sc = None
+    for j in select_modes(result, fmax, modes):
         lam = result.eigenvalues[:, j]
         ax.plot(lam.real, lam.imag, lw=0.8, color="0.6")
         sc = ax.scatter(lam.real, lam.imag, c=V, s=10, cmap="viridis")
         ax.annotate(
-            lab, (lam.real[0], lam.imag[0]), fontsize=7, xytext=(3, 3), textcoords="offset points"
+            f"{j + 1}: {result.mode_labels[j]}",
+            (lam.real[0], lam.imag[0]),
+            fontsize=7,
+            xytext=(3, 3),
+            textcoords="offset points",
         )
-    fig.colorbar(sc, ax=ax, label="airspeed V [m/s]")
+    if sc is not None:
+        unit = "kt" if units == "knots" else "m/s"
+        fig.colorbar(sc, ax=ax, label=f"true airspeed V [{unit}]")
     ax.axvline(0.0, color="k", lw=0.8)
     ax.set_xlabel(r"Re $\lambda$ [1/s]")
     ax.set_ylabel(r"Im $\lambda$ [rad/s]")
     ax.grid(True, alpha=0.3)
     fig.suptitle(title or "root locus versus airspeed")
-    return fig
-
-
-def plot_mode_shapes(model: AeroelasticModel, modes: NaturalModes, *, n: int = 4) -> Figure:
-    """Bending w, twist phi and flap rotations of the first ``n`` natural modes along the span."""
-    n = min(n, modes.shapes.shape[1])
-    fig = _figure(figsize=(7.0, 2.2 * n))
-    axes = np.atleast_1d(fig.subplots(n, 1, sharex=True))
-    for j, ax in enumerate(axes):
-        fld = model.nodal_fields(modes.shapes[:, j])
-        scale = max(np.max(np.abs(fld["w"])), 1e-30)
-        ax.plot(fld["x"], fld["w"] / scale, label="w (normalized)")
-        ax2 = ax.twinx()
-        ax2.plot(fld["x"], np.degrees(fld["phi"]) / scale, "C1", label=r"$\phi$ [deg per unit w]")
-        for k, key in enumerate(k for k in fld if k.startswith("delta_")):
-            ax2.plot(fld["x"], np.degrees(fld[key]) / scale, f"C{k + 2}--", label=key)
-        ax.set_title(f"{modes.labels[j]}  {modes.frequencies[j]:.4g} Hz", fontsize=9)
-        ax.set_ylabel("w")
-        ax2.set_ylabel("rotation [deg]")
-        ax.grid(True, alpha=0.3)
-    axes[-1].set_xlabel("spanwise station x [m]")
     return fig

@@ -2,10 +2,16 @@
 limits (:mod:`.march`), and the time histories it produces (:mod:`.result`).
 """
 
-from .march import simulate
-from .result import SimulationResult
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "SimulationResult": "result",
+    "simulate": "march",
+}
 
 __all__ = [
     "SimulationResult",
     "simulate",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

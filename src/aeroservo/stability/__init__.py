@@ -4,11 +4,17 @@ divergence boundary (:mod:`.boundary`, :mod:`.divergence`), dense eigenvalue swe
 (:mod:`.pk`).
 """
 
-from .boundary import flutter_boundary
-from .divergence import divergence_speed
-from .pk import pk_flutter
-from .result import Crossing, FlutterResult
-from .sweep import EigenSweep, eigen_sweep
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "Crossing": "result",
+    "EigenSweep": "sweep",
+    "FlutterResult": "result",
+    "divergence_speed": "divergence",
+    "eigen_sweep": "sweep",
+    "flutter_boundary": "boundary",
+    "pk_flutter": "pk",
+}
 
 __all__ = [
     "Crossing",
@@ -19,3 +25,5 @@ __all__ = [
     "flutter_boundary",
     "pk_flutter",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

@@ -270,7 +270,7 @@ def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progres
         method = "dense eig of the full model"
 
         def reference(v: float) -> np.ndarray:
-            return sla.eigvals(full.state_matrix(v))
+            return sla.eigvals(full.state_matrix(v), overwrite_a=True, check_finite=False)
 
     else:
         n_big = min(2 * m, full.n_q)

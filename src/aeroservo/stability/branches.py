@@ -18,10 +18,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.optimize import linear_sum_assignment
 
 from ..system.first_order import FirstOrderSystem
+from .assignment import min_cost_assignment
 
 __all__ = ["Branches", "sweep_branches", "is_complex"]
 
@@ -67,10 +66,19 @@ class Branches:
         return self.speeds.size
 
 
-def _mac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    num = np.abs(np.sum(np.conj(x) * y, axis=0)) ** 2
-    den = np.sum(np.abs(x) ** 2, axis=0) * np.sum(np.abs(y) ** 2, axis=0)
-    return num / np.maximum(den, 1e-300)
+def _predict(speeds: list, lams: list, v: float) -> np.ndarray:
+    """Branch eigenvalues at ``v`` extrapolated from the last (up to) three accepted speeds
+    (Lagrange polynomial: constant, linear, then quadratic)."""
+    n = min(len(speeds), 3)
+    xs, ys = speeds[-n:], lams[-n:]
+    out = np.zeros_like(ys[-1])
+    for i in range(n):
+        weight = 1.0
+        for j in range(n):
+            if j != i:
+                weight *= (v - xs[j]) / (xs[i] - xs[j])
+        out = out + weight * ys[i]
+    return out
 
 
 def sweep_branches(
@@ -122,27 +130,25 @@ def sweep_branches(
     w_all = [np.concatenate([lams[0], np.conj(lams[0])])]
     while V < v_max * (1 - 1e-12):
         nxt = next(s for s in stops if s > V * (1 + 1e-12))
-        h = min(h, nxt - V)
-        V1 = nxt if nxt - V - h < 1e-9 * v_max else V + h
+        # a checkpoint within 10 % beyond the step is reached in this step (no sliver step)
+        V1 = nxt if nxt - V - 1.1 * h < 1e-9 * v_max else V + h
         try:
-            w, X = sla.eig(a0 + V1 * a1 + (V1 * V1) * a2)
+            w, X = np.linalg.eig(a0 + V1 * a1 + (V1 * V1) * a2)
+            w, X = w.astype(complex, copy=False), X.astype(complex, copy=False)
         except (ValueError, np.linalg.LinAlgError) as exc:
             return _done(
                 speeds, lams, vecs, w_all, n_amb, f"eigensolution failed at {V1:.6g} m/s ({exc})"
             )
-        if not np.all(np.isfinite(w)):
+        if not np.isfinite(w).all():
             return _done(
                 speeds, lams, vecs, w_all, n_amb, f"non-finite eigenvalues at {V1:.6g} m/s"
             )
         cand = np.flatnonzero(w.imag >= 0)
         prev = lams[-1]
-        if len(speeds) >= 2:
-            pred = prev + (prev - lams[-2]) * (V1 - V) / (V - speeds[-2])
-        else:
-            pred = prev
+        pred = _predict(speeds, lams, V1)
         scale = np.maximum(np.abs(prev), 1e-3 * np.max(np.abs(prev)) + 1e-12)
         cost = np.abs(w[cand][None, :] - pred[:, None]) / scale[:, None]
-        rows, cols = linear_sum_assignment(cost)
+        rows, cols = min_cost_assignment(cost)
         pick = np.empty(prev.size, dtype=int)
         pick[rows] = cand[cols]
         new_l = w[pick]
@@ -151,18 +157,18 @@ def sweep_branches(
         osc = is_complex(new_l) & is_complex(prev)
         change = np.abs(new_l - prev) / scale
         miss = np.abs(new_l - pred) / scale
-        ok = bool(np.all(change <= 2 * max_rel_change))
+        slow = bool((change <= 2 * max_rel_change).all())
+        ok = slow
         if ok and osc.any():
             d1 = cost[rows, cols]
             c2 = cost.copy()
             c2[rows, cols] = np.inf
             d2 = c2.min(axis=1) if c2.shape[1] > 1 else np.full(rows.size, np.inf)
             clear = d1 <= 0.5 * d2 + 1e-12
-            corr = _mac(vecs[-1], new_x)
+            corr = np.abs(np.einsum("ij,ij->j", vecs[-1].conj(), new_x)) ** 2  # unit vectors
             ok = bool(np.all(clear[osc[rows]]) and np.all(corr[osc] >= mac_min))
-        too_fast = not bool(np.all(change <= 2 * max_rel_change))
-        if not ok and (h > h_ambiguous or (too_fast and h > h_min)):
-            h *= 0.5
+        if not ok and (h > h_ambiguous or (not slow and h > h_min)):
+            h = 0.5 * min(h, V1 - V)
             continue
         n_amb += not ok
         speeds.append(V1)
@@ -172,11 +178,14 @@ def sweep_branches(
         V = V1
         if progress is not None:
             progress(V)
+        # the next step scales the one just taken (a step cut short to reach a checkpoint
+        # does not shrink the next); the predictor's miss grows as h^order
+        order = 3.0 if len(speeds) >= 4 else 2.0
         factor = min(
             0.9 * max_rel_change / max(float(change.max()), 1e-12),
-            0.9 * np.sqrt(pred_tol / max(float(miss.max()), 1e-12)),
+            0.9 * (pred_tol / max(float(miss.max()), 1e-12)) ** (1.0 / order),
         )
-        h = min(h * float(np.clip(factor, 0.5, 2.0)), h_max)
+        h = min(max(h, V1 - speeds[-2]) * min(max(factor, 0.5), 2.0), h_max)
     return _done(speeds, lams, vecs, w_all, n_amb, None)
 
 

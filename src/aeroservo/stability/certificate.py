@@ -27,9 +27,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from ..system.first_order import compressibility_factors
+from .assignment import min_cost_assignment
 from .branches import Branches, is_complex
 
 __all__ = ["Certificate", "certify", "truncated_modes", "DENSE_LIMIT", "CERT_ZETA", "MATCH"]
@@ -147,7 +147,7 @@ def certify(
         if lam_f.size == 0:
             continue
         cost = np.abs(lam_f[:, None] - known[None, :]) / np.abs(lam_f)[:, None]
-        rows, cols = linear_sum_assignment(cost)
+        rows, cols = min_cost_assignment(cost)
         dist = np.full(lam_f.size, np.inf)
         dist[rows] = cost[rows, cols]
         for lam, d in zip(lam_f, dist, strict=True):
@@ -192,20 +192,23 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
     m = 1.0 + rho * diag(am.Mnc)
     knc, cnc = diag(am.Knc), diag(am.Cnc)
     groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
+    V = np.linspace(v_max / 16, v_max, 16)[:, None]  # speeds down, modes across
+    w = np.broadcast_to(w0, (V.size, w0.size))
+    for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
+        k = w0**2 + rho * V * V * knc
+        c = rho * V * cnc
+        for b, pq, pd in groups:
+            C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
+            F, G = C.real, C.imag
+            k = k + rho * (-V * V * F * pq + w * V * G * pd)
+            c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
+        w = np.sqrt(np.clip(k / m, 0.0, None))
     bad: dict[int, str] = {}
-    for V in np.linspace(v_max / 16, v_max, 16):
-        w = w0.copy()
-        for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
-            k = w0**2 + rho * V * V * knc
-            c = rho * V * cnc
-            for b, pq, pd in groups:
-                C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
-                F, G = C.real, C.imag
-                k = k + rho * (-V * V * F * pq + w * V * G * pd)
-                c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
-            w = np.sqrt(np.clip(k / m, 0.0, None))
-        for j in np.flatnonzero(c <= 0):
-            bad.setdefault(int(j), f"negative aerodynamic damping at {V:.4g} m/s")
-        for j in np.flatnonzero(w <= KEEP_FREQUENCY * w0):
-            bad.setdefault(int(j), f"frequency down to {w[j] / (2 * np.pi):.4g} Hz at {V:.4g} m/s")
+    for i, v in enumerate(V[:, 0]):  # the first speed at which each mode fails
+        for j in np.flatnonzero(c[i] <= 0):
+            bad.setdefault(int(j), f"negative aerodynamic damping at {v:.4g} m/s")
+        for j in np.flatnonzero(w[i] <= KEEP_FREQUENCY * w0):
+            bad.setdefault(
+                int(j), f"frequency down to {w[i, j] / (2 * np.pi):.4g} Hz at {v:.4g} m/s"
+            )
     return [(float(freqs[n_kept + j]), why) for j, why in sorted(bad.items())]

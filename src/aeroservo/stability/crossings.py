@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .branches import Branches, is_complex
+from .brent import brentq
 from .modal import ModalSystem
 from .result import Crossing
 from .tracking import EigenTracker, mac
@@ -150,7 +151,6 @@ def sign_changes(
     list of (speed, rising, k)
         Root [m/s], whether the measure goes from negative to positive, grid interval.
     """
-    from scipy.optimize import brentq, minimize_scalar
 
     def root(k: int, a: float, b: float) -> float:
         return float(brentq(fun, a, b, args=(k,), xtol=rtol * b, rtol=1e-15))
@@ -167,6 +167,8 @@ def sign_changes(
             if abs(zeta[k]) >= HUMP_ZETA:
                 continue
             # search both grid intervals around the extreme, continuing from the left one
+            from scipy.optimize import minimize_scalar  # only for a hump (rare)
+
             sol = minimize_scalar(
                 lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
                 bounds=(V[k - 1], V[k + 1]),

@@ -17,11 +17,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..aero.atmosphere import Atmosphere
 from ..errors import InputError
 from ..system.first_order import MACH_APPROXIMATE, MACH_LIMIT, compressibility_factors
+from .brent import brentq
 from .divergence import divergence_speeds, static_speeds
 from .result import Crossing, FlutterResult
 

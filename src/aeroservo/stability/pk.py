@@ -27,6 +27,7 @@ from ..errors import check_int, check_number
 from ..system.first_order import check_mach, compressibility_factors
 from ..system.matrices import AeroMatrices
 from .boundary import default_v_max
+from .brent import brentq
 from .divergence import static_speeds
 from .modal import modal_basis
 from .result import Crossing, FlutterResult
@@ -234,8 +235,6 @@ def pk_flutter(
                 P[i:, j] = complex(np.nan, np.nan)  # NaN frequency and damping
                 ended[f"mode {j + 1}"] = float(speeds[i])
                 break
-
-    from scipy.optimize import brentq
 
     crossings = []
     skipped: list[float] = []

@@ -11,6 +11,7 @@ import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..errors import InputError
+from .assignment import min_cost_assignment
 from .boundary import _as_system
 
 __all__ = ["EigenSweep", "eigen_sweep"]
@@ -48,8 +49,6 @@ def eigen_sweep(model: object, speeds: np.ndarray, density: float | None = None)
     -------
     EigenSweep
     """
-    from scipy.optimize import linear_sum_assignment
-
     system, _ = _as_system(model, density)
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size < 1 or np.any(np.diff(speeds) <= 0):
@@ -61,7 +60,7 @@ def eigen_sweep(model: object, speeds: np.ndarray, density: float | None = None)
         X = X / np.linalg.norm(X, axis=0)
         if prev is not None:
             corr = np.abs(prev.conj().T @ X) ** 2
-            rows, cols = linear_sum_assignment(-corr)
+            rows, cols = min_cost_assignment(-corr)
             order = cols[np.argsort(rows)]
             w, X = w[order], X[:, order]
         out[i] = w

@@ -3,9 +3,18 @@ surfaces and actuators (:mod:`.wing`), the spanwise mesh (:mod:`.mesh`), the aer
 element's shape functions (:mod:`.beam_element`) and the built-in wings (:mod:`.examples`).
 """
 
-from . import examples
-from .mesh import Mesh, build_mesh
-from .wing import Actuator, ControlSurface, Segment, Wing
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "Actuator": "wing",
+    "ControlSurface": "wing",
+    "Mesh": "mesh",
+    "Segment": "wing",
+    "Wing": "wing",
+    "build_mesh": "mesh",
+}
+
+_MODULES = {"examples": "examples"}
 
 __all__ = [
     "Actuator",
@@ -16,3 +25,5 @@ __all__ = [
     "build_mesh",
     "examples",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC, _MODULES)

@@ -2,8 +2,14 @@
 design and controller parameters on Dask (:mod:`.trade`).
 """
 
-from .runs import Run, run_scenario
-from .scenario import Scenario, quick
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "Run": "runs",
+    "Scenario": "scenario",
+    "quick": "scenario",
+    "run_scenario": "runs",
+}
 
 __all__ = [
     "Run",
@@ -11,3 +17,5 @@ __all__ = [
     "quick",
     "run_scenario",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

@@ -4,10 +4,16 @@ density-independent matrices (:mod:`.assembly`, :mod:`.matrices`), the first-ord
 together: a wing stick model (:mod:`.aeroelastic`) and a typical section (:mod:`.section`).
 """
 
-from .aeroelastic import AeroelasticModel, NaturalModes
-from .first_order import FirstOrderSystem
-from .matrices import AeroMatrices, StripGroup
-from .section import TypicalSection
+from .._lazy import lazy_attributes
+
+_PUBLIC = {
+    "AeroMatrices": "matrices",
+    "AeroelasticModel": "aeroelastic",
+    "FirstOrderSystem": "first_order",
+    "NaturalModes": "aeroelastic",
+    "StripGroup": "matrices",
+    "TypicalSection": "section",
+}
 
 __all__ = [
     "AeroMatrices",
@@ -17,3 +23,5 @@ __all__ = [
     "StripGroup",
     "TypicalSection",
 ]
+
+__getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

@@ -221,7 +221,7 @@ def _closed_loop(
     ctrl = loop.design_controller(spec, speed, study.sample_rate, v_ol)
 
     stage[0] = "closed_loop"
-    b = closed_loop_boundary(loop.plant, ctrl, v_max, n_grid=study.n_grid, reference_speed=speed)
+    b = closed_loop_boundary(loop, ctrl, v_max, n_grid=study.n_grid, reference_speed=speed)
     stable = b.stable_at_reference
     if stable:
         onset = b.flutter

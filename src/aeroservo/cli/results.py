@@ -1,0 +1,171 @@
+"""Command line: ``plot`` (redraw a saved result) and ``export`` (a state-space model for MATLAB
+/ Simulink or NumPy)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .options import add_flight_options, add_model_options, positive_float
+
+__all__ = ["add_parsers", "HANDLERS"]
+
+KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
+
+
+def _mode_list(text: str) -> list[int]:
+    try:
+        out = [int(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give mode numbers such as 1,2,4") from None
+    if not out or min(out) < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: mode numbers start at 1")
+    return out
+
+
+def _names(text: str) -> list[str]:
+    out = [t.strip() for t in text.split(",") if t.strip()]
+    if not out:
+        raise argparse.ArgumentTypeError(f"{text!r}: give signal names separated by commas")
+    return out
+
+
+def add_parsers(sub) -> None:
+    """The parsers of ``plot`` and ``export``."""
+    pl = sub.add_parser(
+        "plot",
+        help="redraw a saved result (.npz): a flutter sweep or a simulation",
+        description="Redraw a result saved by 'aeroservo flutter --save' (V-g, V-f, root locus, "
+        "mode shapes, flutter mode) or written by 'aeroservo simulate' (time histories).",
+    )
+    pl.add_argument("result", help="result file (.npz)")
+    pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
+    pl.add_argument("--kind", choices=KINDS, default="vg", help="flutter figure (default vg)")
+    pl.add_argument("--fmax", type=positive_float, metavar="HZ", help="modes up to HZ only")
+    pl.add_argument("--modes", type=_mode_list, metavar="LIST", help="modes to draw, e.g. 1,2,4")
+    pl.add_argument("--units", choices=("si", "knots"), default="si", help="speed units")
+    pl.add_argument("--eas", action="store_true", help="equivalent airspeed on the speed axis")
+    pl.add_argument("--g-required", type=positive_float, metavar="G", help="required damping")
+
+    ex = sub.add_parser(
+        "export",
+        help="write a state-space model for MATLAB/Simulink (.mat) or NumPy (.npz)",
+        description="Export A, B, C, D with signal names and units at one flight condition; "
+        "MATLAB: matlab/load_aeroservo.m builds a named ss from the .mat file.",
+    )
+    ex.add_argument("wing", help="built-in wing, a wing .toml or a scenario .toml")
+    ex.add_argument("--speed", type=positive_float, required=True, help="airspeed [m/s]")
+    ex.add_argument("--inputs", type=_names, help="input signals (default: hinge moments, gust)")
+    ex.add_argument("--outputs", type=_names, help="output signals (default: tip sensors)")
+    ex.add_argument("--design-modes", type=int, help="truncate to this many structural modes")
+    ex.add_argument("--physical", action="store_true", help="physical (unbalanced) states")
+    ex.add_argument("--out", required=True, metavar="FILE", help="model.mat or model.npz")
+    add_flight_options(ex)
+    add_model_options(ex)
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..atomic import save_figure
+    from ..errors import InputError
+    from ..files.results import load_result
+
+    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
+    from .analysis import _check_figure
+
+    _check_figure(str(out))
+    res = load_result(args.result)
+    if not hasattr(res, "pk"):  # a simulation
+        if args.kind != "vg" or args.fmax or args.modes or args.eas:
+            raise InputError(
+                f"{args.result}: a simulation result; --kind and mode options apply "
+                "to flutter results"
+            )
+        fig = res.plot()
+    else:
+        fig = _flutter_figure(res, args)
+    save_figure(fig, out, dpi=130)
+    print(f"plot written to {out}")
+    return 0
+
+
+def _flutter_figure(saved, args: argparse.Namespace):
+    from ..errors import InputError
+    from ..plots.flutter import plot_root_locus, plot_vg, select_modes
+    from ..plots.modes import plot_modes
+
+    r, title = saved.result, saved.meta.get("title") or None
+    if args.kind in ("vg", "vf"):
+        fig = plot_vg(
+            r,
+            title=title,
+            units=args.units,
+            eas=args.eas,
+            fmax=args.fmax,
+            modes=args.modes,
+            pk=saved.pk,
+            g_required=args.g_required,
+        )
+        if args.kind == "vf":  # the frequency panel alone
+            ax_f, ax_g = fig.axes[:2]
+            fig.delaxes(ax_g)
+            ax_f.set_xlabel(ax_g.get_xlabel())
+            ax_f.tick_params(labelbottom=True)
+        return fig
+    if args.kind == "root-locus":
+        return plot_root_locus(r, title=title, fmax=args.fmax, modes=args.modes, units=args.units)
+    if not saved.modes:
+        raise InputError(f"{args.result}: the file has no mode shapes")
+    if args.kind == "modes":
+        freqs = saved.modes["frequency"]
+        cols = [j for j in select_modes(r, args.fmax, args.modes) if j < freqs.size]
+        return plot_modes(
+            saved.modes,
+            saved.modes["label"],
+            freqs,
+            surfaces=saved.surfaces,
+            modes=cols,
+            title=title,
+        )
+    if saved.flutter_mode is None or r.flutter is None:
+        raise InputError(f"{args.result}: no flutter in the sweep, so no flutter mode")
+    fields = dict(saved.flutter_mode)
+    fields = {k: (v if k == "x" else v[:, None]) for k, v in fields.items()}
+    fl = r.flutter
+    label = f"flutter mode ({r.mode_labels[fl.mode]}) at {fl.speed:.4g} m/s"
+    return plot_modes(fields, [label], [fl.frequency], surfaces=saved.surfaces, title=title)
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..errors import InputError, check_int
+    from ..files.statespace_export import export_mat, export_npz
+    from ..linear.models import statespace
+    from .options import setup
+
+    suffix = Path(args.out).suffix.lower()
+    if suffix not in (".mat", ".npz"):
+        raise InputError(f"--out = {args.out!r}: expected a .mat or .npz file name")
+    s = setup(args)
+    n_modes = None
+    if args.design_modes is not None:
+        n_modes = check_int("--design-modes", args.design_modes, lo=1, hi=s.model.n_dofs)
+    sys = statespace(
+        s.model,
+        args.speed,
+        s.density,
+        args.inputs,
+        args.outputs,
+        n_modes=n_modes,
+        balanced=not args.physical,
+    )
+    (export_mat if suffix == ".mat" else export_npz)(sys, args.out)
+    print(
+        f"{s.wing.name} at {args.speed:g} m/s, {s.density:.5g} kg/m^3: {sys.nstates} states, "
+        f"inputs {list(sys.input_labels)}, outputs {list(sys.output_labels)} -> {args.out}"
+    )
+    return 0
+
+
+HANDLERS = {"plot": _cmd_plot, "export": _cmd_export}
