@@ -86,11 +86,16 @@ def _vg_checks(fig, result):
 
 def test_vg_plot_is_readable(sweep):
     r, pk, _ = sweep
-    _vg_checks(plot_vg(r, pk=pk), r)
+    fig = plot_vg(r, pk=pk)  # default: modes up to 3 x the flutter frequency, the rest counted
+    _vg_checks(fig, r)
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    n_high = int(np.sum(r.frequencies[0] > 3 * r.flutter_frequency))
+    assert n_high > 0 and f"{n_high} more modes not drawn" in texts
+    _vg_checks(plot_vg(r, pk=pk, fmax=None), r)
     fig = plot_vg(r, fmax=20.0)
     _vg_checks(fig, r)
     labels = fig.legends[0].get_texts()
-    modes = [t.get_text() for t in labels if t.get_text()[0].isdigit()]
+    modes = [t.get_text() for t in labels if t.get_text().split(":")[0].isdigit()]
     f0 = r.frequencies[0]
     assert len(modes) == int(np.sum(f0 <= 20.0)) and len(modes) < len(r.mode_labels)
 
@@ -313,3 +318,27 @@ def test_simulation_results_still_load(tmp_path):
 def test_crossing_dataclass_round_trip_is_exact():
     c = Crossing(137.1, 11.0, 1, "onset")
     assert Crossing(float(c.speed), float(c.frequency), int(c.mode), str(c.kind)) == c
+
+
+def test_envelope_saved_and_redrawn(tmp_path, capsys):
+    saved, png = tmp_path / "env.json", tmp_path / "env.png"
+    argv = ["envelope", "goland", "--altitudes", "0:4000:2000", "--vd", "110", "--save", str(saved)]
+    assert main(argv) == 0
+    env = aes.load_result(saved)
+    data = json.loads(saved.read_text())
+    assert [p.flutter_speed for p in env.points] == [p["flutter_speed"] for p in data["points"]]
+    assert env.vd == 110.0 and env.margin_ok == data["margin_ok"]
+    assert main(["plot", str(saved), "--out", str(png)]) == 0 and png.stat().st_size > 10_000
+    assert main(["plot", str(saved), "--kind", "modes", "--out", str(png)]) == 2
+    assert "is a flutter envelope" in capsys.readouterr().err
+
+
+def test_flutter_mode_animation_from_a_saved_sweep(sweep, tmp_path, capsys):
+    from PIL import Image
+
+    gif = tmp_path / "flutter.gif"
+    assert main(["plot", str(sweep[2]), "--kind", "flutter-mode", "--out", str(gif)]) == 0
+    with Image.open(gif) as im:
+        assert im.n_frames == 36
+    assert main(["plot", str(sweep[2]), "--kind", "vg", "--out", str(tmp_path / "v.gif")]) == 2
+    assert "a .gif animates" in capsys.readouterr().err

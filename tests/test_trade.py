@@ -153,6 +153,12 @@ def test_load_and_plots(run, tmp_path):
     ):
         assert isinstance(fig, Figure)
         fig.savefig(tmp_path / "f.png")
+    from aeroservo.cli import main  # the command line redraws the folder (issue 13)
+
+    for kind in ("pareto", "heatmap"):
+        assert main(["plot", str(out), "--kind", kind, "--out", str(tmp_path / f"{kind}.png")]) == 0
+        assert (tmp_path / f"{kind}.png").stat().st_size > 5_000
+    assert main(["plot", str(out), "--kind", "vg", "--out", str(tmp_path / "x.png")]) == 2
     with pytest.raises(InputError, match="metric = 'nope'"):
         loaded.heatmap("nope")
     with pytest.raises(InputError, match="x = 'speed_factor'"):

@@ -80,6 +80,7 @@ def add_parsers(sub) -> None:
     e.add_argument("--json", action="store_true", help="print one JSON object")
     e.add_argument("--csv", metavar="FILE", help="write the table (one row per altitude)")
     e.add_argument("--plot", metavar="FILE", help="write the envelope plot (png, pdf, svg)")
+    e.add_argument("--save", metavar="FILE.json", help="save the envelope for 'aeroservo plot'")
     e.add_argument("--x", choices=("eas", "mach"), default="eas", help="plot axis")
     e.add_argument(
         "--progress",
@@ -239,6 +240,7 @@ def _cmd_envelope(args: argparse.Namespace) -> int:
     from ..studies.envelope import flutter_envelope, parse_altitudes
 
     _check_figure(args.plot)
+    _check_suffix("--save", args.save, ".json")
     alts = parse_altitudes(args.altitudes_ft, "ft") if args.altitudes_ft else None
     alts = alts or parse_altitudes(args.altitudes)
     s = setup(args, altitudes=True)
@@ -268,6 +270,9 @@ def _cmd_envelope(args: argparse.Namespace) -> int:
     if args.plot:
         fig = env.plot(units=args.units, x=args.x)
         items.append((Path(args.plot), figure_writer(fig, args.plot, dpi=150)))
+    if args.save:
+        text = json_text({"format": "aeroservo-envelope-1", **env.to_dict()})
+        items.append((Path(args.save), lambda p: p.write_text(text, encoding="utf-8")))
     atomic_write_set(items)
     for p in env.points:
         for w in p.warnings:
@@ -276,7 +281,7 @@ def _cmd_envelope(args: argparse.Namespace) -> int:
         print(json_text(env.to_dict()))
         return 0
     print(_envelope_text(env, args.units))
-    for kind, path in (("table", args.csv), ("plot", args.plot)):
+    for kind, path in (("table", args.csv), ("plot", args.plot), ("envelope", args.save)):
         if path:
             print(f"{kind} written to {path}")
     return 0
@@ -345,7 +350,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 def _mode_figures(args: argparse.Namespace, model, modes) -> None:
     """The ``--plot`` and ``--animate`` files of ``aeroservo modes`` (written as a set)."""
     from ..atomic import atomic_write_set, figure_writer
-    from ..plots.modes import animate_mode, mode_fields, plot_modes
+    from ..plots.modes import gif_writer, mode_fields, plot_modes
 
     fields = mode_fields(model, modes.shapes)
     cols = [args.mode - 1] if args.mode else list(range(modes.frequencies.size))
@@ -359,20 +364,8 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
         writers.append((args.plot, figure_writer(fig, args.plot, dpi=130)))
     if args.animate:
         j = (args.mode or 1) - 1
-        tip = model.wing.segments[-1]
-        cs = [c for c in model.wing.control_surfaces if c.end >= model.wing.span - 1e-9]
-        fig, anim = animate_mode(
-            fields,
-            j,
-            label=modes.labels[j],
-            frequency=float(modes.frequencies[j]),
-            semichord=tip.semichord,
-            elastic_axis=tip.a,
-            hinge=cs[0].hinge if cs else None,
-        )
-        from matplotlib.animation import PillowWriter
-
-        writers.append((args.animate, lambda p: anim.save(p, writer=PillowWriter(fps=20))))
+        kw = {"label": modes.labels[j], "frequency": float(modes.frequencies[j])}
+        writers.append((args.animate, gif_writer(fields, j, model.wing, **kw)))
     atomic_write_set(writers)
     for path, _ in writers:
         print(f"written {path}", file=sys.stderr)

@@ -9,7 +9,8 @@ from .options import add_flight_options, add_model_options, positive_float
 
 __all__ = ["add_parsers", "HANDLERS"]
 
-KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
+FLUTTER_KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
+KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope")
 
 
 def _mode_list(text: str) -> list[int]:
@@ -33,14 +34,21 @@ def add_parsers(sub) -> None:
     """The parsers of ``plot`` and ``export``."""
     pl = sub.add_parser(
         "plot",
-        help="redraw a saved result (.npz): a flutter sweep or a simulation",
-        description="Redraw a result saved by 'aeroservo flutter --save' (V-g, V-f, root locus, "
-        "mode shapes, flutter mode) or written by 'aeroservo simulate' (time histories).",
+        help="redraw a saved result: flutter sweep, simulation, trade study or envelope",
+        description="Redraw a result: a sweep saved by 'aeroservo flutter --save' (kinds vg, "
+        "vf, root-locus, modes, flutter-mode), a simulation written by 'aeroservo simulate' "
+        "(time), a trade study's folder (pareto, heatmap) or an envelope saved by 'aeroservo "
+        "envelope --save' (envelope).",
     )
-    pl.add_argument("result", help="result file (.npz)")
+    pl.add_argument("result", help="result file (.npz, envelope .json) or trade folder")
     pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
-    pl.add_argument("--kind", choices=KINDS, default="vg", help="flutter figure (default vg)")
-    pl.add_argument("--fmax", type=positive_float, metavar="HZ", help="modes up to HZ only")
+    pl.add_argument("--kind", choices=KINDS, help="figure (default: vg, time, pareto, envelope)")
+    pl.add_argument(
+        "--fmax",
+        type=positive_float,
+        metavar="HZ",
+        help="modes up to HZ only (default: 3 x the highest crossing frequency)",
+    )
     pl.add_argument("--modes", type=_mode_list, metavar="LIST", help="modes to draw, e.g. 1,2,4")
     pl.add_argument("--units", choices=("si", "knots"), default="si", help="speed units")
     pl.add_argument("--eas", action="store_true", help="equivalent airspeed on the speed axis")
@@ -69,24 +77,78 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from ..atomic import save_figure
     from ..errors import InputError
     from ..files.results import load_result
-
-    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
     from .analysis import _check_figure
 
-    _check_figure(str(out))
-    res = load_result(args.result)
-    if not hasattr(res, "pk"):  # a simulation
-        if args.kind != "vg" or args.fmax or args.modes or args.eas:
-            raise InputError(
-                f"{args.result}: a simulation result; --kind and mode options apply "
-                "to flutter results"
-            )
-        fig = res.plot()
-    else:
+    src = Path(args.result)
+    out = (
+        Path(args.out) if args.out else src.with_suffix(".png") if src.suffix else src / "plot.png"
+    )
+    gif = out.suffix.lower() == ".gif"
+    if gif and args.kind not in ("modes", "flutter-mode"):
+        raise InputError(f"--out = {str(out)!r}: a .gif animates --kind modes or flutter-mode")
+    if not gif:
+        _check_figure(str(out))
+    res = load_result(src)
+    what, kinds = _what(res)
+    kind = args.kind or kinds[0]
+    if kind not in kinds:
+        raise InputError(f"--kind = {kind!r}: {args.result} is {what}; use {', '.join(kinds)}")
+    if gif:
+        return _animate_saved(res, args, out)
+    if what != "a flutter sweep" and (args.fmax or args.modes or args.eas):
+        raise InputError(f"--fmax, --modes and --eas apply to flutter sweeps, not to {what}")
+    if kind in FLUTTER_KINDS:
+        args.kind = kind
         fig = _flutter_figure(res, args)
+    elif kind == "time":
+        fig = res.plot()
+    elif kind == "envelope":
+        fig = res.plot(units=args.units)
+    else:
+        fig = res.pareto() if kind == "pareto" else res.heatmap()
     save_figure(fig, out, dpi=130)
     print(f"plot written to {out}")
     return 0
+
+
+def _animate_saved(saved, args: argparse.Namespace, out) -> int:
+    """A tip-section animation of a saved sweep's flutter mode or of one natural mode."""
+    import tomllib
+
+    from ..atomic import atomic_write
+    from ..errors import InputError
+    from ..files.wing_file import wing_from_dict
+    from ..plots.modes import gif_writer
+
+    r = saved.result
+    if not saved.modes:
+        raise InputError(f"{args.result}: the file has no mode shapes")
+    wing = wing_from_dict(tomllib.loads(saved.wing_text)["wing"], f"{args.result}: wing")
+    if args.kind == "flutter-mode":
+        if saved.flutter_mode is None or r.flutter is None:
+            raise InputError(f"{args.result}: no flutter in the sweep, so no flutter mode")
+        fields = {k: (v if k == "x" else v[:, None]) for k, v in saved.flutter_mode.items()}
+        j, label, freq = 0, f"flutter mode at {r.flutter.speed:.4g} m/s", r.flutter.frequency
+    else:
+        fields = saved.modes
+        j = (args.modes or [1])[0] - 1
+        if j >= fields["frequency"].size:
+            raise InputError(f"--modes: the file has {fields['frequency'].size} mode shapes")
+        label, freq = fields["label"][j], float(fields["frequency"][j])
+    atomic_write(out, gif_writer(fields, j, wing, label=label, frequency=freq))
+    print(f"animation written to {out}")
+    return 0
+
+
+def _what(res) -> tuple[str, tuple]:
+    """What a loaded result is, and the figure kinds it has (default first)."""
+    if hasattr(res, "pk"):
+        return "a flutter sweep", FLUTTER_KINDS
+    if hasattr(res, "pareto"):
+        return "a trade study", ("pareto", "heatmap")
+    if hasattr(res, "margin_ok"):
+        return "a flutter envelope", ("envelope",)
+    return "a simulation", ("time",)
 
 
 def _flutter_figure(saved, args: argparse.Namespace):
@@ -101,7 +163,7 @@ def _flutter_figure(saved, args: argparse.Namespace):
             title=title,
             units=args.units,
             eas=args.eas,
-            fmax=args.fmax,
+            fmax=args.fmax or "auto",
             modes=args.modes,
             pk=saved.pk,
             g_required=args.g_required,

@@ -20,6 +20,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..stability.result import Crossing, FlutterResult
+from .summaries import json_text
 
 __all__ = ["FORMAT", "SavedFlutter", "flutter_writer", "read_flutter"]
 
@@ -180,21 +181,13 @@ def flutter_writer(
         if q is not None:
             arrays.update(_mode_fields(model, q, "flutter_mode."))
     arrays["wing_text"] = np.array(wing_text)
-    arrays["meta"] = np.array(json.dumps(meta, default=_plain))
+    arrays["meta"] = np.array(json_text(meta))
 
     def write(p: Path) -> None:
         with open(p, "wb") as fh:
             np.savez_compressed(fh, **arrays)
 
     return write
-
-
-def _plain(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
 
 
 def _need(data: dict, key: str, path: Path, kind: str, ndim: int, shape=None) -> np.ndarray:

@@ -12,21 +12,9 @@ import numpy as np
 
 from ..atomic import atomic_write
 from ..errors import InputError
+from .summaries import json_text
 
 __all__ = ["save_result", "load_result", "result_writer", "json_text"]
-
-
-def json_text(obj: object) -> str:
-    """JSON text of a summary (numpy scalars and arrays as plain numbers and lists)."""
-
-    def default(o):
-        if isinstance(o, np.generic):
-            return o.item()
-        if isinstance(o, np.ndarray):
-            return o.tolist()
-        return str(o)
-
-    return json.dumps(obj, indent=2, default=default)
 
 
 def result_writer(result, summary: dict | None = None):
@@ -86,12 +74,43 @@ def save_result(result, path: str | Path, summary: dict | None = None, **kw) -> 
     return atomic_write(path, result_writer(result, summary))
 
 
+def _load_envelope(path: Path):
+    """A flutter envelope saved by ``aeroservo envelope --save FILE.json``."""
+    from ..studies.envelope import Envelope
+
+    try:
+        if path.stat().st_size > 50_000_000:
+            raise InputError(f"{path}: larger than 50 MB; not an aeroservo envelope")
+        data = json.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such result file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{path}: not an aeroservo envelope ({exc})") from None
+    if not isinstance(data, dict) or data.get("format") != "aeroservo-envelope-1":
+        raise InputError(
+            f"{path}: not a saved aeroservo result (a JSON summary? save a sweep with "
+            "'aeroservo flutter ... --save FILE.npz', an envelope with 'aeroservo envelope ... "
+            "--save FILE.json')"
+        )
+    try:
+        return Envelope.from_dict(data)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+
+
 def load_result(path: str | Path):
-    """Read a result written by :func:`save_result`: a ``SimulationResult``, or a
-    :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep."""
+    """Read a result written by :func:`save_result`: a ``SimulationResult``, a
+    :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep, a trade study's
+    folder (``TradeResult``) or a flutter envelope saved as JSON (``Envelope``)."""
     from .flutter_file import FORMAT, open_npz, read_flutter
 
     path = Path(path)
+    if path.is_dir():
+        from ..studies.trade.results import load_trade
+
+        return load_trade(path)
+    if path.suffix.lower() == ".json":
+        return _load_envelope(path)
     data, meta = open_npz(path)
     fmt = meta.get("format")
     if fmt == FORMAT:

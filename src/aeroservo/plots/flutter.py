@@ -25,12 +25,31 @@ def _figure(**kw) -> Figure:
     return Figure(layout="constrained", **kw)
 
 
+AUTO_FMAX = 3.0
+"""``fmax="auto"``: modes up to this many times the highest crossing frequency (or, without a
+crossing, the second mode's frequency at rest) are drawn."""
+
+
+def auto_fmax(result: FlutterResult) -> float:
+    """The frequency [Hz] up to which ``fmax="auto"`` draws modes."""
+    f_cross = [c.frequency for c in result.crossings if c.frequency > 0]
+    f0 = np.sort(result.frequencies[0][np.isfinite(result.frequencies[0])])
+    ref = max(f_cross) if f_cross else (f0[min(1, f0.size - 1)] if f0.size else np.inf)
+    return AUTO_FMAX * float(ref)
+
+
 def select_modes(
-    result: FlutterResult, fmax: float | None = None, modes: Sequence[int] | None = None
+    result: FlutterResult, fmax: float | str | None = None, modes: Sequence[int] | None = None
 ) -> list[int]:
     """Indices of the branches to draw: ``modes`` (1-based), or those whose frequency at the
-    start of the sweep is at most ``fmax`` [Hz], or all."""
+    start of the sweep is at most ``fmax`` [Hz] (``"auto"``: :func:`auto_fmax`), or all."""
     n = len(result.mode_labels)
+    if isinstance(fmax, str):
+        if fmax != "auto":
+            from ..errors import InputError
+
+            raise InputError(f"fmax = {fmax!r}: a frequency [Hz], 'auto' or None")
+        fmax = auto_fmax(result)
     if modes is not None:
         bad = [m for m in modes if not 1 <= int(m) <= n]
         if bad:
@@ -58,7 +77,7 @@ def plot_vg(
     g_required: float | None = None,
     units: str = "si",
     eas: bool = False,
-    fmax: float | None = None,
+    fmax: float | str | None = "auto",
     modes: Sequence[int] | None = None,
     pk: FlutterResult | None = None,
 ) -> Figure:
@@ -83,9 +102,10 @@ def plot_vg(
         Speed axis in m/s or knots.
     eas : bool
         Equivalent instead of true airspeed on the speed axis.
-    fmax : float, optional
+    fmax : float, "auto" or None
         Draw only the modes whose frequency at the start of the sweep is at most ``fmax`` [Hz]
-        (the flutter mode is always drawn).
+        (the flutter mode is always drawn); ``"auto"`` (default): :data:`AUTO_FMAX` x the
+        highest crossing frequency; None: every mode. The legend says how many are left out.
     modes : sequence of int, optional
         Draw only these modes (1-based, as in the table); overrides ``fmax``.
     pk : FlutterResult, optional
@@ -131,6 +151,9 @@ def plot_vg(
             ax_g.plot(fp.speed * scale, 0.0, "X", color="k", ms=8, label="p-k flutter")
             ax_f.plot(fp.speed * scale, fp.frequency, "X", color="k", ms=8)
     ax_f.plot([], [], ":", color="0.4", lw=2.0, label="overdamped (real roots)")
+    left_out = len(result.mode_labels) - len(select_modes(result, fmax, modes))
+    if left_out:
+        ax_f.plot([], [], " ", label=f"{left_out} more mode{'s' * (left_out > 1)} not drawn")
     ax_g.axhline(0.0, color="k", lw=0.8)
     if g_required is not None:
         label = f"g = -{g_required:g} (required damping)"

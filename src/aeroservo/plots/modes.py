@@ -17,7 +17,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["mode_fields", "plot_mode_shapes", "plot_modes", "animate_mode"]
+__all__ = ["mode_fields", "plot_mode_shapes", "plot_modes", "animate_mode", "gif_writer"]
 
 
 def mode_fields(model, shapes: np.ndarray) -> dict:
@@ -204,3 +204,23 @@ def animate_mode(
         return wing, flap, ea
 
     return fig, FuncAnimation(fig, draw, frames=frames, interval=50, blit=True)
+
+
+def gif_writer(fields: dict, j: int, wing, *, label: str, frequency: float):
+    """A writer (for :mod:`aeroservo.atomic`) of the tip-section animation of mode ``j`` of
+    ``fields`` on ``wing`` (its tip semichord and elastic axis, and the hinge of a surface that
+    reaches the tip), as a GIF (Pillow)."""
+    from matplotlib.animation import PillowWriter
+
+    tip = wing.segments[-1]
+    cs = [c for c in wing.control_surfaces if c.end >= wing.span - 1e-9]
+    _, anim = animate_mode(
+        fields,
+        j,
+        label=label,
+        frequency=frequency,
+        semichord=tip.semichord,
+        elastic_axis=tip.a,
+        hinge=cs[0].hinge if cs else None,
+    )
+    return lambda p: anim.save(p, writer=PillowWriter(fps=20))

@@ -108,6 +108,26 @@ class Envelope:
         out.update(self.info)
         return out
 
+    @classmethod
+    def from_dict(cls, data: dict) -> Envelope:
+        """The envelope of :meth:`to_dict` (e.g. read back from ``envelope --save``)."""
+        names = set(EnvelopePoint.__dataclass_fields__)
+        try:
+            points = [
+                EnvelopePoint(**{k: v for k, v in p.items() if k in names}) for p in data["points"]
+            ]
+            return cls(
+                points=points,
+                vd=data.get("vd_eas"),
+                md=data.get("md"),
+                margin=data.get("margin") or MARGIN,
+                compressibility=data.get("compressibility"),
+                damping=str(data.get("damping", "none")),
+                wing=str(data.get("wing", "")),
+            )
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise InputError(f"not a valid flutter envelope ({exc})") from None
+
     @property
     def envelope(self) -> bool:
         return self.vd is not None or self.md is not None

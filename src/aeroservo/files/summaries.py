@@ -1,0 +1,24 @@
+"""JSON text of run summaries and result headers (numpy scalars and arrays as plain numbers and
+lists), the one encoder every result file and ``--json`` output uses."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+__all__ = ["json_text"]
+
+
+def _plain(o: object) -> object:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
+
+
+def json_text(obj: object, indent: int | None = 2) -> str:
+    """JSON text of ``obj``: numpy scalars and arrays become plain numbers and lists, anything
+    else unknown its ``str``."""
+    return json.dumps(obj, indent=indent, default=_plain)
