@@ -11,8 +11,9 @@ speed-up, the projected time of 10 000 cases on 2 workers (target: <= 15 min), t
 compute time of one case, and whether the two runs' CSV tables agree.
 
 Run: ``make bench`` (or ``python bench/bench_trade.py``); ``--quick`` runs 4 x 4 x 3 = 48
-cases on 2 workers only (a smoke test). Other load on the machine lowers the rates: the load
-averages and the share of a core each worker got are printed.
+cases on 2 workers only (a smoke test); ``--two-workers`` skips the 1-worker run; ``--csv FILE``
+keeps the 2-worker table. Other load on the machine lowers the rates: the load averages and the
+share of a core each worker got are printed.
 """
 
 from __future__ import annotations
@@ -84,7 +85,7 @@ def main() -> None:
     print(f"  load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     res = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for w in (2,) if quick else (1, 2):
+        for w in (2,) if quick or "--two-workers" in sys.argv else (1, 2):
             r = measure(study, w, os.path.join(tmp, f"w{w}"))
             res[w] = r
             print(
@@ -96,6 +97,8 @@ def main() -> None:
         print(f"  speed-up 2 workers / 1 worker: {res[2]['rate'] / res[1]['rate']:.2f} x")
         same = res[1]["table"].equals(res[2]["table"])
         print(f"  1-worker and 2-worker tables identical: {same}")
+    if "--csv" in sys.argv:  # keep the 2-worker table (e.g. to compare two versions' results)
+        res[2]["table"].to_csv(sys.argv[sys.argv.index("--csv") + 1], index=False)
     t10k = 10_000 / res[2]["rate"]
     print(
         f"  projected 10 000 cases on 2 workers: {t10k:.0f} s ({t10k / 60:.1f} min) "

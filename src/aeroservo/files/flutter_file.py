@@ -107,15 +107,6 @@ def _sweep_meta(r: FlutterResult) -> dict:
     return meta
 
 
-def _mode_fields(model, q: np.ndarray, prefix: str) -> dict:
-    """Nodal fields of a mode, scaled so that its largest deflection or rotation (w in m, phi
-    and the flap rotations in rad; the slope is left out) is real and equal to 1."""
-    fld = {k: v for k, v in model.nodal_fields(q).items() if k != "theta"}
-    values = np.concatenate([v for k, v in fld.items() if k != "x"])
-    top = values[int(np.argmax(np.abs(values)))]
-    return {f"{prefix}{k}": (v if k == "x" else v / top) for k, v in fld.items()}
-
-
 def _flutter_vector(model, result: FlutterResult) -> np.ndarray | None:
     """Structural part of the full model's eigenvector at the flutter speed (None without
     flutter)."""
@@ -166,12 +157,7 @@ def flutter_writer(
         arrays.update(_sweep_arrays("pk.", pk))
     if model is not None and hasattr(model, "natural_modes"):
         modes = model.natural_modes(min(len(result.mode_labels), model.n_dofs))
-        for j in range(modes.shapes.shape[1]):
-            fld = _mode_fields(model, modes.shapes[:, j], "")
-            for k, v in fld.items():
-                arrays.setdefault(f"modes.{k}", []).append(v)
-        arrays = {k: (np.stack(v, axis=1) if isinstance(v, list) else v) for k, v in arrays.items()}
-        arrays["modes.x"] = arrays["modes.x"][:, 0]
+        arrays.update({f"modes.{k}": v for k, v in model.mode_fields(modes.shapes).items()})
         arrays["modes.frequency"] = np.asarray(modes.frequencies, dtype=float)
         meta["mode_labels"] = list(modes.labels)
         meta["surfaces"] = {
@@ -179,7 +165,8 @@ def flutter_writer(
         }
         q = _flutter_vector(model, result)
         if q is not None:
-            arrays.update(_mode_fields(model, q, "flutter_mode."))
+            fld = model.mode_fields(q[:, None])
+            arrays.update({f"flutter_mode.{k}": v if k == "x" else v[:, 0] for k, v in fld.items()})
     arrays["wing_text"] = np.array(wing_text)
     arrays["meta"] = np.array(json_text(meta))
 

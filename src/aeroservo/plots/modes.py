@@ -21,19 +21,9 @@ __all__ = ["mode_fields", "plot_mode_shapes", "plot_modes", "animate_mode", "gif
 
 
 def mode_fields(model, shapes: np.ndarray) -> dict:
-    """Normalised nodal fields of mode shapes (columns of ``shapes``) of a model, with the keys
-    of a saved result's ``modes``: ``x`` (n_nodes,), ``w``, ``phi``, ``delta_<surface>``
-    (n_nodes, n_modes)."""
-    cols = []
-    for j in range(shapes.shape[1]):
-        fld = {k: v for k, v in model.nodal_fields(shapes[:, j]).items() if k != "theta"}
-        values = np.concatenate([v for k, v in fld.items() if k != "x"])
-        top = values[int(np.argmax(np.abs(values)))]
-        cols.append({k: v / top for k, v in fld.items() if k != "x"})
-    out = {"x": model.mesh.nodes.copy()}
-    for k in cols[0]:
-        out[k] = np.stack([c[k] for c in cols], axis=1)
-    return out
+    """Normalised nodal fields of mode shapes of a model
+    (:meth:`~aeroservo.system.aeroelastic.AeroelasticModel.mode_fields`)."""
+    return model.mode_fields(shapes)
 
 
 def _on_surface(x: np.ndarray, y: np.ndarray, span: Sequence[float] | None) -> np.ndarray:

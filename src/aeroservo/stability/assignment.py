@@ -29,11 +29,11 @@ def min_cost_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m, n = cost.shape
     if m <= n:
         cols = np.argmin(cost, axis=1)
-        if np.unique(cols).size == m:
+        if len(set(cols.tolist())) == m:
             return np.arange(m), cols
     else:
         rows = np.argmin(cost, axis=0)
-        if np.unique(rows).size == n:
+        if len(set(rows.tolist())) == n:
             order = np.argsort(rows)
             return rows[order], np.arange(n)[order]
     from scipy.optimize import linear_sum_assignment

@@ -153,7 +153,7 @@ def sweep_branches(
         pick[rows] = cand[cols]
         new_l = w[pick]
         new_x = X[:, pick]
-        new_x = new_x / np.linalg.norm(new_x, axis=0)
+        new_x = new_x / np.sqrt(np.einsum("ij,ij->j", new_x.conj(), new_x).real)
         osc = is_complex(new_l) & is_complex(prev)
         change = np.abs(new_l - prev) / scale
         miss = np.abs(new_l - pred) / scale
@@ -166,7 +166,7 @@ def sweep_branches(
             d2 = c2.min(axis=1) if c2.shape[1] > 1 else np.full(rows.size, np.inf)
             clear = d1 <= 0.5 * d2 + 1e-12
             corr = np.abs(np.einsum("ij,ij->j", vecs[-1].conj(), new_x)) ** 2  # unit vectors
-            ok = bool(np.all(clear[osc[rows]]) and np.all(corr[osc] >= mac_min))
+            ok = bool(clear[osc[rows]].all() and (corr[osc] >= mac_min).all())
         if not ok and (h > h_ambiguous or (not slow and h > h_min)):
             h = 0.5 * min(h, V1 - V)
             continue

@@ -178,6 +178,27 @@ class AeroelasticModel:
             fields[f"delta_{cs.name}"] = take(m.dof_delta[k])
         return fields
 
+    def mode_fields(self, shapes: np.ndarray) -> dict[str, np.ndarray]:
+        """Nodal fields of mode shapes (columns of ``shapes``, real or complex), each scaled so
+        that its largest deflection or rotation (``w`` in m, ``phi`` and the flap rotations in
+        rad; the slope is left out) is real and equal to 1.
+
+        Returns a dict with ``"x"`` (n_nodes,) [m] and ``"w"``, ``"phi"``, ``"delta_<surface>"``
+        (n_nodes, n_modes).
+        """
+        shapes = np.asarray(shapes)
+        cols = []
+        for j in range(shapes.shape[1]):
+            fld = {
+                k: v for k, v in self.nodal_fields(shapes[:, j]).items() if k not in ("x", "theta")
+            }
+            values = np.concatenate(list(fld.values()))
+            top = values[int(np.argmax(np.abs(values)))]
+            cols.append({k: v / top for k, v in fld.items()})
+        out = {"x": self.mesh.nodes.copy()}
+        out.update({k: np.stack([c[k] for c in cols], axis=1) for k in cols[0]})
+        return out
+
 
 def _ordinal(n: int) -> str:
     suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
