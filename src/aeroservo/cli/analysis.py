@@ -236,7 +236,7 @@ def _cmd_envelope(args: argparse.Namespace) -> int:
 
     from ..aero.atmosphere import KNOT
     from ..atomic import atomic_write_set, figure_writer
-    from ..files.results import json_text
+    from ..files.summaries import json_text
     from ..studies.envelope import flutter_envelope, parse_altitudes
 
     _check_figure(args.plot)
@@ -350,9 +350,9 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 def _mode_figures(args: argparse.Namespace, model, modes) -> None:
     """The ``--plot`` and ``--animate`` files of ``aeroservo modes`` (written as a set)."""
     from ..atomic import atomic_write_set, figure_writer
-    from ..plots.modes import gif_writer, mode_fields, plot_modes
+    from ..plots.modes import gif_writer, plot_modes
 
-    fields = mode_fields(model, modes.shapes)
+    fields = model.mode_fields(modes.shapes)
     cols = [args.mode - 1] if args.mode else list(range(modes.frequencies.size))
     surfaces = {cs.name: (cs.start, cs.end) for cs in model.wing.control_surfaces}
     writers = []

@@ -98,8 +98,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if what != "a flutter sweep" and (args.fmax or args.modes or args.eas):
         raise InputError(f"--fmax, --modes and --eas apply to flutter sweeps, not to {what}")
     if kind in FLUTTER_KINDS:
-        args.kind = kind
-        fig = _flutter_figure(res, args)
+        fig = _flutter_figure(res, kind, args)
     elif kind == "time":
         fig = res.plot()
     elif kind == "envelope":
@@ -151,13 +150,13 @@ def _what(res) -> tuple[str, tuple]:
     return "a simulation", ("time",)
 
 
-def _flutter_figure(saved, args: argparse.Namespace):
+def _flutter_figure(saved, kind: str, args: argparse.Namespace):
     from ..errors import InputError
     from ..plots.flutter import plot_root_locus, plot_vg, select_modes
     from ..plots.modes import plot_modes
 
     r, title = saved.result, saved.meta.get("title") or None
-    if args.kind in ("vg", "vf"):
+    if kind in ("vg", "vf"):
         fig = plot_vg(
             r,
             title=title,
@@ -168,17 +167,17 @@ def _flutter_figure(saved, args: argparse.Namespace):
             pk=saved.pk,
             g_required=args.g_required,
         )
-        if args.kind == "vf":  # the frequency panel alone
+        if kind == "vf":  # the frequency panel alone
             ax_f, ax_g = fig.axes[:2]
             fig.delaxes(ax_g)
             ax_f.set_xlabel(ax_g.get_xlabel())
             ax_f.tick_params(labelbottom=True)
         return fig
-    if args.kind == "root-locus":
+    if kind == "root-locus":
         return plot_root_locus(r, title=title, fmax=args.fmax, modes=args.modes, units=args.units)
     if not saved.modes:
         raise InputError(f"{args.result}: the file has no mode shapes")
-    if args.kind == "modes":
+    if kind == "modes":
         freqs = saved.modes["frequency"]
         cols = [j for j in select_modes(r, args.fmax, args.modes) if j < freqs.size]
         return plot_modes(

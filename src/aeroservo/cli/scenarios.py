@@ -65,8 +65,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from ..files.outputs import write_run
-    from ..files.results import json_text
     from ..files.scenario_file import load_scenario
+    from ..files.summaries import json_text
     from ..studies.runs import run_scenario
     from ..studies.scenario import quick
 

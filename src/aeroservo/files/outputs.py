@@ -17,7 +17,8 @@ from pathlib import Path
 
 from ..atomic import atomic_write_set, figure_writer
 from ..studies.runs import Run
-from .results import json_text, result_writer
+from .results import result_writer
+from .summaries import json_text
 
 __all__ = ["write_run"]
 

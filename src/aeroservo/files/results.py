@@ -14,7 +14,7 @@ from ..atomic import atomic_write
 from ..errors import InputError
 from .summaries import json_text
 
-__all__ = ["save_result", "load_result", "result_writer", "json_text"]
+__all__ = ["save_result", "load_result", "result_writer"]
 
 
 def result_writer(result, summary: dict | None = None):

@@ -17,13 +17,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["mode_fields", "plot_mode_shapes", "plot_modes", "animate_mode", "gif_writer"]
-
-
-def mode_fields(model, shapes: np.ndarray) -> dict:
-    """Normalised nodal fields of mode shapes of a model
-    (:meth:`~aeroservo.system.aeroelastic.AeroelasticModel.mode_fields`)."""
-    return model.mode_fields(shapes)
+__all__ = ["plot_mode_shapes", "plot_modes", "animate_mode", "gif_writer"]
 
 
 def _on_surface(x: np.ndarray, y: np.ndarray, span: Sequence[float] | None) -> np.ndarray:
@@ -77,7 +71,8 @@ def plot_modes(
     Parameters
     ----------
     fields : dict
-        Nodal fields (:func:`mode_fields`, or a saved result's ``modes``); complex fields (the
+        Nodal fields (:meth:`~aeroservo.system.aeroelastic.AeroelasticModel.mode_fields`, or a
+        saved result's ``modes``); complex fields (the
         flutter mode) are drawn as real (solid) and imaginary (dashed) parts.
     labels, frequencies : sequence
         Name and frequency [Hz] of each column.
@@ -114,7 +109,7 @@ def plot_modes(
 def plot_mode_shapes(model, modes, *, n: int = 4) -> Figure:
     """The first ``n`` natural modes of a model (``modes``: :class:`NaturalModes`)."""
     n = min(n, modes.shapes.shape[1])
-    fields = mode_fields(model, modes.shapes[:, :n])
+    fields = model.mode_fields(modes.shapes[:, :n])
     surfaces = {cs.name: (cs.start, cs.end) for cs in model.wing.control_surfaces}
     return plot_modes(fields, modes.labels[:n], modes.frequencies[:n], surfaces=surfaces)
 
