@@ -133,7 +133,7 @@ FLUTTER_MODULES = {
     "aeroservo.errors",
     *(f"aeroservo.aero{m}" for m in ("", ".atmosphere", ".indicial", ".theodorsen")),
     *(f"aeroservo.cli{m}" for m in ("", ".analysis", ".options", ".results", ".scenarios")),
-    *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".wing_file")),
+    *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".user_files", ".wing_file")),
     *(
         f"aeroservo.stability{m}"
         for m in (

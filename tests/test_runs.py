@@ -90,7 +90,7 @@ def test_plot_command_replots_a_result(tmp_path, capsys):
     (tmp_path / "junk.npz").write_bytes(b"not a zip")
     assert cli.main(["plot", str(tmp_path / "junk.npz")]) == 2
     err = capsys.readouterr().err
-    assert "no such result file" in err and "not an aeroservo result file" in err
+    assert "missing.npz: no such file" in err and "not an aeroservo result file" in err
 
 
 def test_failed_write_leaves_no_partial_result(tmp_path, monkeypatch):

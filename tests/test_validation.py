@@ -32,7 +32,10 @@ CS = dict(
 @pytest.mark.parametrize(
     "field,value,match",
     [
-        ("EI", -1.0, r"EI = -1: allowed range is \(0, inf\) \[N m\^2\]"),
+        ("EI", -1.0, r"EI = -1: allowed range is \[1e-06, 1e\+13\] \[N m\^2\]"),
+        ("EI", 1e308, r"EI = 1e\+308: allowed range"),
+        ("GJ", 1e-300, r"GJ = 1e-300: allowed range"),
+        ("mass", 1e7, r"mass = 1e\+07: allowed range"),
         ("GJ", 0.0, "GJ = 0"),
         ("mass", float("nan"), "mass = nan: must be a finite number"),
         ("semichord", "wide", "semichord = 'wide': expected a real number"),

@@ -66,7 +66,10 @@ def test_kussner_sets_start_at_zero():
         ({"A": [0.2, 0.3], "b": [0.1]}, "same number"),
         ({"A": [0.7, 0.6], "b": [0.1, 0.2]}, "sum"),
         ({"A": [0.5], "c": [0.1]}, "keys"),
-        ({"A": ["x"], "b": [0.1]}, "numbers"),
+        ({"A": ["x"], "b": [0.1]}, r"A\[0\] = .x.: expected a real number"),
+        ({"A": [True], "b": [0.1]}, r"A\[0\] = True"),
+        ({"A": "0.165", "b": [0.1]}, "list of numbers"),
+        ({"A": [0.1], "b": [1e308]}, r"b\[0\] = 1e\+308: allowed range"),
         (3.0, "expected"),
     ],
 )

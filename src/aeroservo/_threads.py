@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import os
+import sys
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -21,6 +22,7 @@ __all__ = ["blas_limited", "blas_threads"]
 
 F = TypeVar("F", bound=Callable)
 _controller = None
+_n_modules = 0
 
 
 def blas_threads() -> int:
@@ -42,11 +44,13 @@ def blas_limited(fn: F) -> F:
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        global _controller
-        if _controller is None:
+        global _controller, _n_modules
+        if _controller is None or len(sys.modules) != _n_modules:
+            # the pools are found once; again after an import, which may have loaded a BLAS
             from threadpoolctl import ThreadpoolController
 
             _controller = ThreadpoolController()
+            _n_modules = len(sys.modules)
         with _controller.limit(limits=blas_threads()):
             return fn(*args, **kwargs)
 

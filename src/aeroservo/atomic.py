@@ -12,17 +12,63 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-__all__ = ["atomic_write", "atomic_write_text", "atomic_write_set", "save_figure"]
+__all__ = [
+    "atomic_write",
+    "atomic_write_text",
+    "atomic_write_set",
+    "save_figure",
+    "check_output_path",
+]
 
 Writer = Callable[[Path], None]
 
 
-def _temporary(path: Path) -> Path:
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        from .errors import InputError
+_TEMP_EXTRA = 10
+"""Characters a temporary name adds to the destination's: a dot, another and 8 random."""
 
-        raise InputError(f"output = {str(path)!r}: folder {str(folder)!r} does not exist")
+
+def check_output_path(path: str | Path, option: str = "output") -> Path:
+    """Refuse an output path that cannot be written, before anything is computed.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination file.
+    option : str
+        The option or key that named it, for the message.
+
+    Raises
+    ------
+    InputError
+        The folder does not exist, the path is a folder, or the name (with the temporary name
+        the atomic writer uses) is longer than the file system allows.
+    """
+    from .errors import InputError
+
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not path.name or path.name in (".", ".."):
+        raise InputError(f"{option} = {str(path)!r}: expected a file name")
+    if not folder.is_dir():
+        raise InputError(f"{option} = {str(path)!r}: folder {str(folder)!r} does not exist")
+    try:
+        name_max = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        name_max = 255
+    longest = name_max - _TEMP_EXTRA - len(path.suffix.encode())
+    if len(path.name.encode()) > longest:
+        raise InputError(
+            f"{option} = {str(path)[:60]!r}...: file name of {len(path.name.encode())} bytes; "
+            f"this file system allows {longest} for an output"
+        )
+    if path.is_dir():
+        raise InputError(f"{option} = {str(path)!r}: is a folder, expected a file name")
+    return path
+
+
+def _temporary(path: Path) -> Path:
+    check_output_path(path)
+    folder = path.parent if str(path.parent) else Path(".")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=folder)
     os.close(fd)
     return Path(tmp)

@@ -49,7 +49,9 @@ def check_number(
             else:
                 raise TypeError
         except TypeError:
-            raise InputError(f"{field} = {value!r}: expected a real number{unit_txt}") from None
+            raise InputError(
+                f"{field} = {show_value(value)}: expected a real number{unit_txt}"
+            ) from None
     v = float(value)
     if not math.isfinite(v):
         raise InputError(f"{field} = {v!r}: must be a finite number{unit_txt}")
@@ -60,6 +62,15 @@ def check_number(
         right = "inf)" if hi is None else f"{hi:g}" + (")" if hi_open else "]")
         raise InputError(f"{field} = {v:g}: allowed range is {left}, {right}{unit_txt}")
     return v
+
+
+def show_value(value: object) -> str:
+    """A value as shown in a message: its repr on one line, at most 80 characters."""
+    try:
+        text = " ".join(repr(value).split())
+    except Exception:  # a repr that fails (e.g. an integer too long to print)
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def check_int(field: str, value: object, *, lo: int | None = None, hi: int | None = None) -> int:
@@ -73,9 +84,94 @@ def check_int(field: str, value: object, *, lo: int | None = None, hi: int | Non
             else:
                 raise TypeError
         except TypeError:
-            raise InputError(f"{field} = {value!r}: expected an integer") from None
+            raise InputError(f"{field} = {show_value(value)}: expected an integer") from None
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         left = "-inf" if lo is None else str(lo)
         right = "inf" if hi is None else str(hi)
         raise InputError(f"{field} = {value}: allowed range is [{left}, {right}]")
     return int(value)
+
+
+class Range:
+    """The allowed values of one physical quantity: the one rule files, CLI and API share.
+
+    Parameters
+    ----------
+    lo, hi : float
+        Bounds [unit].
+    unit : str
+        SI unit shown in messages.
+    lo_open, hi_open : bool
+        Whether the bound itself is excluded.
+    """
+
+    __slots__ = ("lo", "hi", "unit", "lo_open", "hi_open")
+
+    def __init__(self, lo, hi, unit="", lo_open=False, hi_open=False):
+        self.lo, self.hi, self.unit = lo, hi, unit
+        self.lo_open, self.hi_open = lo_open, hi_open
+
+    def text(self) -> str:
+        """The range as written in messages and in ``docs/conventions.md``."""
+        left = ("(" if self.lo_open else "[") + f"{self.lo:g}"
+        right = f"{self.hi:g}" + (")" if self.hi_open else "]")
+        return f"{left}, {right}" + (f" {self.unit}" if self.unit else "")
+
+
+MAX_ELEMENTS = 400
+"""Most beam elements of a model (files, CLI and API): a dense 3 300-state system."""
+
+RANGES: dict[str, Range] = {
+    # flight condition
+    "density": Range(1e-4, 2.0, "kg/m^3"),
+    "airspeed": Range(0.0, 1000.0, "m/s"),
+    "flight_speed": Range(0.1, 1000.0, "m/s"),
+    "speed_factor": Range(0.05, 10.0),
+    # wing geometry, mass and stiffness
+    "span": Range(1e-3, 1e4, "m"),
+    "semichord": Range(1e-4, 1e3, "m"),
+    "mass_per_length": Range(1e-6, 1e6, "kg/m"),
+    "inertia_per_length": Range(0.0, 1e6, "kg m", lo_open=True),
+    "static_moment": Range(-1e6, 1e6, "kg m/m"),
+    "stiffness": Range(1e-6, 1e13, "N m^2"),
+    "flap_stiffness": Range(0.0, 1e13, "N m^2"),
+    "hinge_stiffness": Range(0.0, 1e12, "N m/rad per m"),
+    "actuator_stiffness": Range(0.0, 1e12, "N m/rad", lo_open=True),
+    # aerodynamics
+    "wagner_coefficient": Range(0.0, 1.0, lo_open=True),
+    "wagner_exponent": Range(1e-4, 1000.0),
+    "gust_length": Range(0.01, 1e5, "m"),
+    "gust_velocity": Range(-50.0, 50.0, "m/s"),
+    # time marching and control
+    "duration": Range(0.0, 600.0, "s", lo_open=True),
+    "time": Range(0.0, 600.0, "s"),
+    "sample_rate": Range(1.0, 1e5, "Hz"),
+    "bryson": Range(1e-9, 1e9, "signal units"),
+    "limit": Range(0.0, 1e12, "signal units (per s for rates)", lo_open=True),
+    "variance": Range(0.0, 1e6, "signal units^2"),
+    "frequency": Range(0.0, 1e5, "Hz"),
+}
+"""Allowed range of every physical quantity (documented in ``docs/conventions.md``)."""
+
+
+def check_quantity(field: str, value: object, quantity: str) -> float:
+    """Validate ``value`` against the range of ``quantity`` in :data:`RANGES`.
+
+    Parameters
+    ----------
+    field
+        Dotted name used in the message (e.g. ``"wing.segments[0].EI"``).
+    value
+        The value to check.
+    quantity
+        A key of :data:`RANGES` (e.g. ``"stiffness"``).
+
+    Raises
+    ------
+    InputError
+        If the value is not a finite real number within the quantity's range.
+    """
+    r = RANGES[quantity]
+    return check_number(
+        field, value, unit=r.unit, lo=r.lo, hi=r.hi, lo_open=r.lo_open, hi_open=r.hi_open
+    )

@@ -16,9 +16,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_int, check_number
+from ..errors import RANGES, InputError, check_int, check_number
 
 __all__ = ["OneMinusCosine", "Turbulence", "GustSeries", "dryden_psd", "von_karman_psd"]
+
+LENGTHS = (RANGES["gust_length"].lo, RANGES["gust_length"].hi)
+"""Allowed gust lengths and turbulence scales [m]."""
+VELOCITIES = (RANGES["gust_velocity"].lo, RANGES["gust_velocity"].hi)
+"""Allowed gust velocities [m/s] (amplitudes and series values)."""
+TIMES = (RANGES["time"].lo, RANGES["time"].hi)
+"""Allowed gust times [s] (start, series times)."""
+MAX_SIGMA = 30.0
+"""Largest RMS turbulence velocity [m/s]."""
 
 
 @dataclass(frozen=True)
@@ -28,11 +37,11 @@ class OneMinusCosine:
     Parameters
     ----------
     length : float
-        Gust length (distance flown through it) [m].
+        Gust length (distance flown through it) [m], in [0.01, 1e5].
     amplitude : float
-        Peak vertical velocity [m/s], positive up.
+        Peak vertical velocity [m/s], positive up, in [-50, 50].
     start : float
-        Time the gust starts [s].
+        Time the gust starts [s], in [0, 600].
     """
 
     length: float
@@ -40,11 +49,14 @@ class OneMinusCosine:
     start: float = 0.0
 
     def __post_init__(self) -> None:
-        check_number("gust.length", self.length, unit="m", lo=0.0, lo_open=True)
-        check_number("gust.amplitude", self.amplitude, unit="m/s")
-        check_number("gust.start", self.start, unit="s", lo=0.0)
+        check_number("gust.length", self.length, unit="m", lo=LENGTHS[0], hi=LENGTHS[1])
+        check_number(
+            "gust.amplitude", self.amplitude, unit="m/s", lo=VELOCITIES[0], hi=VELOCITIES[1]
+        )
+        check_number("gust.start", self.start, unit="s", lo=TIMES[0], hi=TIMES[1])
 
     def __call__(self, t: np.ndarray, speed: float) -> np.ndarray:
+        speed = check_number("speed", speed, unit="m/s", lo=0.0)
         t = np.asarray(t, dtype=float)
         s = (t - self.start) * speed / self.length
         inside = (s >= 0) & (s <= 1)
@@ -76,9 +88,10 @@ class Turbulence:
     Parameters
     ----------
     sigma : float
-        RMS gust velocity [m/s].
+        RMS gust velocity [m/s], in [0, 30].
     scale : float
-        Turbulence scale length L [m] (e.g. 533 m above 2000 ft for MIL-F-8785C von Karman).
+        Turbulence scale length L [m] (e.g. 533 m above 2000 ft for MIL-F-8785C von Karman), in
+        (0, 1e5].
     model : {"von_karman", "dryden"}
     seed : int
         Random seed: the same seed gives the same signal.
@@ -90,16 +103,17 @@ class Turbulence:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        check_number("turbulence.sigma", self.sigma, unit="m/s", lo=0.0)
-        check_number("turbulence.scale", self.scale, unit="m", lo=0.0, lo_open=True)
+        check_number("turbulence.sigma", self.sigma, unit="m/s", lo=0.0, hi=MAX_SIGMA)
+        check_number("turbulence.scale", self.scale, unit="m", lo=0.0, lo_open=True, hi=LENGTHS[1])
         check_int("turbulence.seed", self.seed, lo=0)
-        if self.model not in ("von_karman", "dryden"):
+        if not isinstance(self.model, str) or self.model not in ("von_karman", "dryden"):
             raise InputError(
                 f"turbulence.model = {self.model!r}: allowed values are 'von_karman', 'dryden'"
             )
 
     def __call__(self, t: np.ndarray, speed: float) -> np.ndarray:
         """Signal on a uniform time grid ``t`` [s] (random phases, exact spectral amplitudes)."""
+        speed = check_number("speed", speed, unit="m/s", lo=0.0, lo_open=True)
         t = np.asarray(t, dtype=float)
         n = t.size
         if n < 2:
@@ -129,25 +143,50 @@ class GustSeries:
     Parameters
     ----------
     time : array_like
-        Increasing times [s].
+        Increasing times [s], in [0, 600].
     velocity : array_like
-        Vertical gust velocity [m/s] at those times.
+        Vertical gust velocity [m/s] at those times, in [-50, 50].
     """
 
     time: tuple
     velocity: tuple
 
     def __post_init__(self) -> None:
-        t = np.asarray(self.time, dtype=float)
-        w = np.asarray(self.velocity, dtype=float)
+        t, w = (
+            _series("gust series: time", self.time),
+            _series("gust series: velocity", self.velocity),
+        )
         if t.ndim != 1 or t.shape != w.shape or t.size < 2:
             raise InputError(
-                "gust series: time and velocity must be 1-D arrays of the same length >= 2"
+                "gust series: time and velocity must be 1-D arrays of the same length >= 2 "
+                f"(got shapes {t.shape} and {w.shape})"
             )
-        if np.any(np.diff(t) <= 0) or not np.all(np.isfinite(w)) or not np.all(np.isfinite(t)):
-            raise InputError("gust series: time must increase and all values must be finite")
+        for name, a, (lo, hi), unit in (
+            ("time", t, TIMES, "s"),
+            ("velocity", w, VELOCITIES, "m/s"),
+        ):
+            for i in np.flatnonzero(~np.isfinite(a) | (a < lo) | (a > hi))[:1]:
+                check_number(f"gust series: {name}[{i}]", float(a[i]), unit=unit, lo=lo, hi=hi)
+        for i in np.flatnonzero(np.diff(t) <= 0)[:1]:
+            raise InputError(
+                f"gust series: time[{i + 1}] = {t[i + 1]:g}: time must increase "
+                f"(time[{i}] = {t[i]:g}) [s]"
+            )
         object.__setattr__(self, "time", tuple(t))
         object.__setattr__(self, "velocity", tuple(w))
 
     def __call__(self, t: np.ndarray, speed: float) -> np.ndarray:
         return np.interp(np.asarray(t, dtype=float), self.time, self.velocity, left=0.0, right=0.0)
+
+
+def _series(field: str, value: object) -> np.ndarray:
+    """A real numeric array (a list, tuple or array of numbers), or InputError."""
+    try:
+        a = None if isinstance(value, (str, bytes)) else np.asarray(value)
+    except ValueError:  # ragged nesting
+        raise InputError(f"{field}: expected a flat list of numbers") from None
+    if a is None or a.ndim == 0:
+        raise InputError(f"{field} = {value!r}: expected a list of numbers")
+    if a.dtype.kind not in "iuf":
+        raise InputError(f"{field}: expected real numbers, got {a.dtype} values")
+    return a.astype(float)

@@ -11,12 +11,12 @@ mesh node, interpolated linearly along the span, the seed's x-bar):
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_quantity
 
 __all__ = [
     "IndicialSet",
@@ -27,6 +27,17 @@ __all__ = [
     "wagner_exact",
     "fit_wagner",
 ]
+
+
+def _coefficients(field: str, values: object, quantity: str) -> tuple[float, ...]:
+    """A non-empty list of numbers within ``quantity``'s range (strings, booleans refused)."""
+    if isinstance(values, np.ndarray):
+        values = values.tolist() if values.ndim == 1 else [values.tolist()]
+    if isinstance(values, (int, float)) and not isinstance(values, bool):
+        values = [values]
+    if not isinstance(values, (list, tuple)) or not values:
+        raise InputError(f"{field} = {values!r}: expected a non-empty list of numbers")
+    return tuple(check_quantity(f"{field}[{i}]", x, quantity) for i, x in enumerate(values))
 
 
 @dataclass(frozen=True)
@@ -52,20 +63,15 @@ class IndicialSet:
     source: str = "user supplied"
 
     def __post_init__(self) -> None:
-        A = tuple(float(x) for x in np.atleast_1d(self.A))
-        b = tuple(float(x) for x in np.atleast_1d(self.b))
+        where = f"indicial set {self.name!r}"
+        A = _coefficients(f"{where}: A", self.A, "wagner_coefficient")
+        b = _coefficients(f"{where}: b", self.b, "wagner_exponent")
         object.__setattr__(self, "A", A)
         object.__setattr__(self, "b", b)
         if len(A) == 0 or len(A) != len(b):
             raise InputError(
-                f"indicial set '{self.name}': A has {len(A)} terms and b has {len(b)}; "
-                "need the same number (>= 1)"
+                f"{where}: A has {len(A)} terms and b has {len(b)}; need the same number (>= 1)"
             )
-        for i, (ai, bi) in enumerate(zip(A, b, strict=True)):
-            if not np.isfinite(ai) or ai <= 0:
-                raise InputError(f"indicial set '{self.name}': A[{i}] = {ai!r}: must be > 0")
-            if not np.isfinite(bi) or bi <= 0:
-                raise InputError(f"indicial set '{self.name}': b[{i}] = {bi!r}: must be > 0")
         if sum(A) > 1.0 + 1e-12:
             raise InputError(
                 f"indicial set '{self.name}': sum(A) = {sum(A):g}: must be <= 1 "
@@ -174,14 +180,17 @@ def _resolve(spec: object, table: Mapping[str, IndicialSet], kind: str) -> Indic
                 f"{kind} = {dict(spec)!r}: a user set needs exactly the keys 'A' and 'b' "
                 "(optionally 'name', 'source')"
             )
-        if not isinstance(spec["A"], Sequence) or not isinstance(spec["b"], Sequence):
-            raise InputError(f"{kind}: 'A' and 'b' must be lists of numbers")
+        A = _coefficients(f"{kind}.A", spec["A"], "wagner_coefficient")
+        b = _coefficients(f"{kind}.b", spec["b"], "wagner_exponent")
+        if len(A) != len(b):
+            raise InputError(
+                f"{kind}: A has {len(A)} terms and b has {len(b)}; need the same number (>= 1)"
+            )
+        name = str(spec.get("name", "user"))
         try:
-            A = tuple(float(x) for x in spec["A"])
-            b = tuple(float(x) for x in spec["b"])
-        except (TypeError, ValueError):
-            raise InputError(f"{kind}: 'A' and 'b' must be lists of numbers") from None
-        return IndicialSet(A, b, str(spec.get("name", "user")), str(spec.get("source", "user")))
+            return IndicialSet(A, b, name, str(spec.get("source", "user")))
+        except InputError as exc:  # named by the key, not by the set's default name
+            raise InputError(str(exc).replace(f"indicial set {name!r}", kind, 1)) from None
     raise InputError(f"{kind} = {spec!r}: expected a set name, an IndicialSet or a mapping")
 
 

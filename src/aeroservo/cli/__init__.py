@@ -81,6 +81,32 @@ def _json_stdout():
         os.close(saved)
 
 
+@contextlib.contextmanager
+def _warnings_in_one_line():
+    """Python warnings raised while a command runs (numpy's floating-point warnings, a
+    library's notices) are printed once each, one line per kind, at the end."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            yield
+        finally:
+            counts: dict[tuple[str, str], int] = {}
+            for w in caught:
+                text = str(w.message).strip().splitlines()
+                key = (w.category.__name__, text[0] if text else "")
+                counts[key] = counts.get(key, 0) + 1
+            for (category, text), n in counts.items():
+                times = f" ({n} times)" if n > 1 else ""
+                hint = (
+                    "; results may be inaccurate: check the magnitudes of the inputs"
+                    if category == "RuntimeWarning"
+                    else ""
+                )
+                print(f"aeroservo: warning: {category}: {text}{times}{hint}", file=sys.stderr)
+
+
 @blas_limited
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
@@ -90,6 +116,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _UsageError as exc:
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2
+    try:
+        with _warnings_in_one_line():
+            return _run(args)
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print(
+            "aeroservo: interrupted (a run writes its files only once complete; a trade study "
+            "resumes where it stopped)",
+            file=sys.stderr,
+        )
+        return 130
+
+
+def _run(args: argparse.Namespace) -> int:
     handlers = {**analysis.HANDLERS, **scenarios.HANDLERS, **results.HANDLERS}
     try:
         if getattr(args, "json", False):
@@ -106,13 +147,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (RuntimeError, ArithmeticError, __import__("numpy").linalg.LinAlgError) as exc:
         if args.debug:
             raise
-        print(f"aeroservo: numerical failure: {exc}", file=sys.stderr)
+        print(f"aeroservo: numerical failure: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
     except Exception as exc:  # a bug: one line, an invitation to report it
         if args.debug:
             raise
+        text = " ".join(str(exc).split())
+        text = text if len(text) <= 200 else text[:197] + "..."
         print(
-            f"aeroservo: internal error: {type(exc).__name__}: {exc} (please report it; "
+            f"aeroservo: internal error: {type(exc).__name__}: {text} (please report it; "
             "'aeroservo --debug ...' shows the traceback)",
             file=sys.stderr,
         )

@@ -6,7 +6,16 @@ import argparse
 import json
 import sys
 
-from .options import add_flight_options, add_model_options, positive_float, positive_int, setup
+from .options import (
+    add_flight_options,
+    add_model_options,
+    elements,
+    named,
+    positive_float,
+    positive_int,
+    quantity,
+    setup,
+)
 
 __all__ = ["add_parsers", "HANDLERS"]
 
@@ -25,7 +34,9 @@ def add_parsers(sub) -> None:
     f.add_argument("--json", action="store_true", help="print one JSON object")
     add_flight_options(f)
     add_model_options(f)
-    f.add_argument("--v-max", type=positive_float, help="upper end of the speed search [m/s]")
+    f.add_argument(
+        "--v-max", type=quantity("flight_speed"), help="upper end of the speed search [m/s]"
+    )
     f.add_argument(
         "--modes",
         type=positive_int,
@@ -91,7 +102,7 @@ def add_parsers(sub) -> None:
 
     m = sub.add_parser("modes", help="natural frequencies of a wing (in vacuo)")
     m.add_argument("wing")
-    m.add_argument("--elements", type=positive_int)
+    m.add_argument("--elements", type=elements)
     m.add_argument("-n", type=positive_int, default=6, help="number of modes (default 6)")
     m.add_argument("--json", action="store_true")
     m.add_argument("--plot", metavar="FILE", help="mode shapes figure (png, pdf, svg)")
@@ -101,26 +112,32 @@ def add_parsers(sub) -> None:
     )
 
 
-def _check_figure(path: str | None) -> None:
+def _check_figure(path: str | None, option: str = "--plot") -> None:
     """Refuse an unknown figure format before computing anything."""
     if path is None:
         return
     from pathlib import Path
 
+    from ..atomic import check_output_path
     from ..errors import InputError
 
     fmt = Path(path).suffix.lstrip(".").lower()
     if fmt not in ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff", "webp"):
-        raise InputError(f"--plot = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
+        raise InputError(f"{option} = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
+    check_output_path(path, option)
 
 
 def _check_suffix(option: str, path: str | None, suffix: str) -> None:
+    if path is None:
+        return
     from pathlib import Path
 
+    from ..atomic import check_output_path
     from ..errors import InputError
 
-    if path is not None and Path(path).suffix.lower() != suffix:
+    if Path(path).suffix.lower() != suffix:
         raise InputError(f"{option} = {path!r}: expected a {suffix} file name")
+    check_output_path(path, option)
 
 
 def _wing_text(spec: str, wing) -> str:
@@ -128,11 +145,12 @@ def _wing_text(spec: str, wing) -> str:
     from pathlib import Path
 
     from ..files.toml_tables import is_scenario_file
+    from ..files.user_files import read_text
     from ..files.wing_file import wing_toml
 
     p = Path(spec)
     if p.suffix == ".toml" and p.is_file() and not is_scenario_file(p):
-        return p.read_text(encoding="utf-8-sig")
+        return read_text(p, what="wing file (TOML)")
     return wing_toml(wing)
 
 
@@ -147,12 +165,13 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
     n_modes = args.modes if args.modes is not None else s.opts.n_modes
     kw = {"v_max": v_max, "n_modes": n_modes}
-    if s.atmosphere is not None:
-        from ..stability.matched import flutter_at
+    with named("n_modes", "--modes" if args.modes is not None else None, args, "n_modes"):
+        if s.atmosphere is not None:
+            from ..stability.matched import flutter_at
 
-        result = flutter_at(model, s.atmosphere, compressibility=s.compressibility, **kw)
-    else:
-        result = flutter_boundary(model, s.density, **kw)
+            result = flutter_at(model, s.atmosphere, compressibility=s.compressibility, **kw)
+        else:
+            result = flutter_boundary(model, s.density, **kw)
     out = {
         "wing": wing.name,
         "flutter_speed": result.flutter_speed,
@@ -212,7 +231,7 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         from ..atomic import atomic_write_set
 
         atomic_write_set(writers)  # all the files, or none
-    for w in result.warnings:
+    for w in dict.fromkeys(result.warnings):  # each once
         print(f"aeroservo: warning: {w}", file=sys.stderr)
     if args.json:
         print(json.dumps(out, indent=2))
@@ -241,6 +260,7 @@ def _cmd_envelope(args: argparse.Namespace) -> int:
 
     _check_figure(args.plot)
     _check_suffix("--save", args.save, ".json")
+    _check_suffix("--csv", args.csv, ".csv")
     alts = parse_altitudes(args.altitudes_ft, "ft") if args.altitudes_ft else None
     alts = alts or parse_altitudes(args.altitudes)
     s = setup(args, altitudes=True)
@@ -322,7 +342,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     _check_figure(args.plot)
     _check_suffix("--animate", args.animate, ".gif")
     wing, opts = resolve_wing(args.wing)
-    model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
+    with named("n_elements", "--elements" if args.elements else None, args, "elements"):
+        model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
     modes = model.natural_modes(min(max(args.n, args.mode or 1), model.n_dofs))
     if args.mode is not None and args.mode > modes.frequencies.size:
         raise InputError(f"--mode = {args.mode}: the model has {modes.frequencies.size} modes")

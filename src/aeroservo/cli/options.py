@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 from dataclasses import dataclass
 
 from ..errors import InputError
 
 __all__ = [
+    "quantity",
+    "elements",
     "positive_float",
     "positive_int",
     "add_model_options",
@@ -37,6 +40,35 @@ def positive_int(text: str) -> int:
     return v
 
 
+def quantity(name: str):
+    """An argparse type: a number within the range of ``name`` in
+    :data:`aeroservo.errors.RANGES`, the rule files and the API use too."""
+    from ..errors import check_quantity
+
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        try:
+            return check_quantity(repr(text), v, name)
+        except InputError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = name  # argparse names the type in some messages
+    return parse
+
+
+def elements(text: str) -> int:
+    """An argparse type: a number of beam elements in [1, MAX_ELEMENTS]."""
+    from ..errors import MAX_ELEMENTS
+
+    v = positive_int(text)
+    if v > MAX_ELEMENTS:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed range is [1, {MAX_ELEMENTS}]")
+    return v
+
+
 def _number(text: str) -> float:
     try:
         v = float(text)
@@ -59,7 +91,7 @@ def _numbers(text: str) -> list[float]:
 def add_model_options(p: argparse.ArgumentParser) -> None:
     """``--elements``, ``--wagner`` and the structural damping options."""
     p.add_argument(
-        "--elements", type=positive_int, help="number of beam elements (default: file, else 10)"
+        "--elements", type=elements, help="number of beam elements (default: file, else 10)"
     )
     p.add_argument("--wagner", help="Wagner set: rt_jones, wp_jones, one_term, fit2, fit3, fit4")
     d = p.add_mutually_exclusive_group()
@@ -88,7 +120,9 @@ def add_flight_options(p: argparse.ArgumentParser) -> None:
     """The flight condition: density or altitude, compressibility, units."""
     f = p.add_mutually_exclusive_group()
     f.add_argument(
-        "--density", type=positive_float, help="air density [kg/m^3] (default: file, else 1.225)"
+        "--density",
+        type=quantity("density"),
+        help="air density [kg/m^3] (default: file, else 1.225)",
     )
     f.add_argument(
         "--altitude", type=_number, metavar="M", help="geopotential altitude [m] (ISA 1976)"
@@ -128,6 +162,29 @@ def _damping(args, default):
             raise InputError(f"--rayleigh = {args.rayleigh}: give ALPHA,BETA")
         return StructuralDamping.rayleigh(*args.rayleigh)
     return default
+
+
+@contextlib.contextmanager
+def named(argument: str, option: str | None, args: argparse.Namespace, key: str):
+    """Re-raise an InputError about the API argument ``argument`` (``"n_elements = 1: ..."``)
+    naming where the value came from: the option if it was given, else the file's key."""
+    try:
+        yield
+    except InputError as exc:
+        msg = str(exc)
+        if not msg.startswith(f"{argument} = "):
+            raise
+        rest = msg[len(argument) :]
+        if option is not None:
+            raise InputError(f"{option}{rest}") from None
+        where = "model" if _is_scenario(args.wing) else "analysis"
+        raise InputError(f"{args.wing}: {where}.{key}{rest}") from None
+
+
+def _is_scenario(spec: str) -> bool:
+    from ..files.toml_tables import is_scenario_file
+
+    return spec.endswith(".toml") and is_scenario_file(spec)
 
 
 def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
@@ -176,5 +233,7 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
         )
     elements = args.elements if args.elements is not None else opts.elements
     wagner = args.wagner if args.wagner is not None else opts.wagner
-    model = AeroelasticModel(wing, elements, wagner, damping=_damping(args, opts.damping))
+    option = "--elements" if args.elements is not None else None
+    with named("n_elements", option, args, "elements"):
+        model = AeroelasticModel(wing, elements, wagner, damping=_damping(args, opts.damping))
     return Setup(wing, model, atm, density, comp, opts)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .options import add_flight_options, add_model_options, positive_float
+from .options import add_flight_options, add_model_options, positive_float, quantity
 
 __all__ = ["add_parsers", "HANDLERS"]
 
@@ -61,7 +61,7 @@ def add_parsers(sub) -> None:
         "MATLAB: matlab/load_aeroservo.m builds a named ss from the .mat file.",
     )
     ex.add_argument("wing", help="built-in wing, a wing .toml or a scenario .toml")
-    ex.add_argument("--speed", type=positive_float, required=True, help="airspeed [m/s]")
+    ex.add_argument("--speed", type=quantity("airspeed"), required=True, help="airspeed [m/s]")
     ex.add_argument("--inputs", type=_names, help="input signals (default: hinge moments, gust)")
     ex.add_argument("--outputs", type=_names, help="output signals (default: tip sensors)")
     ex.add_argument("--design-modes", type=int, help="truncate to this many structural modes")
@@ -77,9 +77,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from ..atomic import save_figure
     from ..errors import InputError
     from ..files.results import load_result
+    from ..files.user_files import check_readable
     from .analysis import _check_figure
 
     src = Path(args.result)
+    if not src.is_dir():
+        check_readable(src, "saved result (.npz, .json) or trade folder")
     out = (
         Path(args.out) if args.out else src.with_suffix(".png") if src.suffix else src / "plot.png"
     )
@@ -87,7 +90,11 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if gif and args.kind not in ("modes", "flutter-mode"):
         raise InputError(f"--out = {str(out)!r}: a .gif animates --kind modes or flutter-mode")
     if not gif:
-        _check_figure(str(out))
+        _check_figure(str(out), "--out")
+    else:
+        from ..atomic import check_output_path
+
+        check_output_path(out, "--out")
     res = load_result(src)
     what, kinds = _what(res)
     kind = args.kind or kinds[0]
@@ -200,6 +207,7 @@ def _flutter_figure(saved, kind: str, args: argparse.Namespace):
 def _cmd_export(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from ..atomic import check_output_path
     from ..errors import InputError, check_int
     from ..files.statespace_export import export_mat, export_npz
     from ..linear.models import statespace
@@ -208,6 +216,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
     suffix = Path(args.out).suffix.lower()
     if suffix not in (".mat", ".npz"):
         raise InputError(f"--out = {args.out!r}: expected a .mat or .npz file name")
+    check_output_path(args.out, "--out")
     s = setup(args)
     n_modes = None
     if args.design_modes is not None:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import InputError, check_int, check_number
+from ..errors import InputError, check_int, check_number, check_quantity
 from .plant import SampledPlant
 
 __all__ = ["HinfWeights", "DiscreteCompensator", "hinf"]
@@ -213,7 +213,7 @@ def hinf(
     from ..linear.reduction import balanced_truncation
 
     w = weights or HinfWeights()
-    dt = 1.0 / check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    dt = 1.0 / check_quantity("sample_rate", sample_rate, "sample_rate")
     for what, scale, names in (
         ("inputs", input_scale, controls),
         ("sensors", sensor_scale, sensors),

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._threads import blas_limited
-from ..errors import InputError, check_number
+from ..errors import InputError, check_number, check_quantity
 from .lqr import Bryson, _balanced_lqr, cost_weights
 from .plant import SampledPlant, select
 
@@ -223,7 +223,7 @@ def lqg(
     """
     import control
 
-    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    rate = check_quantity("sample_rate", sample_rate, "sample_rate")
     dt = 1.0 / rate
     A, B, _, _ = select(sys, controls, [])
     n, m = B.shape

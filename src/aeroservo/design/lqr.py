@@ -14,8 +14,13 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._threads import blas_limited
-from ..errors import InputError, check_number
+from ..errors import RANGES, InputError, check_number
+from ..linear.models import SAMPLE_RATES, check_continuous
+from ..linear.signals import check_names, check_signal_map, describe
 from .plant import SampledPlant, select
+
+BRYSON_RANGE = (RANGES["bryson"].lo, RANGES["bryson"].hi)
+"""Allowed values of Bryson's limits [signal units] (their inverse squares stay finite)."""
 
 __all__ = ["Bryson", "bryson_weights", "cost_weights", "StateFeedback", "lqr"]
 
@@ -27,12 +32,15 @@ class Bryson:
     Parameters
     ----------
     outputs : dict
-        ``{output name: allowed value}`` in the output's unit (e.g. ``{"tip_disp": 0.05}`` m).
+        ``{output name: allowed value}`` in the output's unit (e.g. ``{"tip_disp": 0.05}`` m),
+        values in [1e-9, 1e9].
     inputs : dict
-        ``{control input name: allowed value}`` (e.g. ``{"aileron_hinge_moment": 500.0}`` N m).
+        ``{control input name: allowed value}`` (e.g. ``{"aileron_hinge_moment": 500.0}`` N m),
+        values in [1e-9, 1e9].
     state_weight : float
         Small weight added on every state (times the trace of the output weight / n), to keep
-        the Riccati equation well posed when some states are not seen by the outputs.
+        the Riccati equation well posed when some states are not seen by the outputs; in
+        [0, 1e6].
     """
 
     outputs: dict
@@ -40,12 +48,12 @@ class Bryson:
     state_weight: float = 1e-8
 
     def __post_init__(self) -> None:
+        lo, hi = BRYSON_RANGE
+        for kind in ("outputs", "inputs"):
+            check_signal_map(f"bryson.{kind}", getattr(self, kind), lo=lo, hi=hi, lo_open=False)
         if not self.outputs or not self.inputs:
             raise InputError("bryson: give at least one output and one input limit")
-        for kind in ("outputs", "inputs"):
-            for name, value in getattr(self, kind).items():
-                check_number(f"bryson.{kind}[{name!r}]", value, lo=0.0, lo_open=True)
-        check_number("bryson.state_weight", self.state_weight, lo=0.0)
+        check_number("bryson.state_weight", self.state_weight, lo=0.0, hi=1e6)
 
 
 def bryson_weights(
@@ -55,6 +63,9 @@ def bryson_weights(
 
     Outputs with a direct feedthrough (accelerations) contribute cross and input terms.
     """
+    controls = _controls(sys, controls)
+    if not isinstance(bryson, Bryson):
+        raise InputError(f"bryson = {describe(bryson)}: expected an aeroservo.design.Bryson")
     for c in bryson.inputs:
         if c not in controls:
             raise InputError(f"bryson.inputs: {c!r} is not a control input {list(controls)}")
@@ -78,8 +89,10 @@ def cost_weights(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(Q, R, N)`` of a design from explicit weights or Bryson's rule (exactly one of them).
 
-    ``who`` names the calling design in error messages (``"lqr"``, ``"lqg"``, ``"mpc"``).
+    ``who`` names the calling design in error messages (``"lqr"``, ``"lqg"``, ``"mpc"``). Q must
+    be symmetric positive semi-definite and R symmetric positive definite.
     """
+    controls = _controls(sys, controls)
     A, B, _, _ = select(sys, controls, [])
     n, m = B.shape
     if bryson is not None:
@@ -88,10 +101,47 @@ def cost_weights(
         return bryson_weights(sys, controls, bryson)
     if Q is None or R is None:
         raise InputError(f"{who}: give Q and R, or bryson")
-    Q, R = np.atleast_2d(Q).astype(float), np.atleast_2d(R).astype(float)
-    if Q.shape != (n, n) or R.shape != (m, m):
-        raise InputError(f"{who}: Q must be {n}x{n} and R {m}x{m}")
+    Q = _weight(who, "Q", Q, n, "design states", definite=False)
+    R = _weight(who, "R", R, m, "controls", definite=True)
     return Q, R, np.zeros((n, m))
+
+
+def _controls(sys, controls) -> list[str]:
+    """The control names, checked (a non-empty list of distinct names), and the model type."""
+    check_continuous("sys", sys)
+    controls = check_names("controls", controls)
+    for i, c in enumerate(controls):
+        if c in controls[:i]:
+            raise InputError(f"controls: {c!r} appears twice")
+    return controls
+
+
+def _weight(who: str, name: str, value, n: int, what: str, *, definite: bool) -> np.ndarray:
+    """A real symmetric n x n weight, positive (semi-)definite to a relative tolerance."""
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged nesting
+        a = np.asarray(None)
+    if a.dtype.kind not in "iuf" or a.ndim > 2:
+        raise InputError(f"{who}: {name} = {describe(value)}: expected a real {n}x{n} matrix")
+    a = np.atleast_2d(a).astype(float)
+    if a.shape != (n, n):
+        raise InputError(f"{who}: {name} has shape {a.shape}; expected {n}x{n} ({what})")
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{who}: {name} has NaN or infinite entries")
+    norm = float(np.linalg.norm(a))
+    asym = float(np.abs(a - a.T).max())
+    if asym > 1e-10 * norm:
+        raise InputError(f"{who}: {name} is not symmetric (max |{name} - {name}^T| = {asym:.3g})")
+    a = 0.5 * (a + a.T)
+    low = float(np.linalg.eigvalsh(a)[0])
+    if definite and not low > 1e-12 * norm:
+        raise InputError(f"{who}: {name} must be positive definite (smallest eigenvalue {low:.3g})")
+    if not definite and low < -1e-12 * norm:
+        raise InputError(
+            f"{who}: {name} must be positive semi-definite (smallest eigenvalue {low:.3g})"
+        )
+    return a
 
 
 @dataclass
@@ -184,7 +234,7 @@ def lqr(
     bryson : Bryson, optional
         Output and input limits (Bryson's rule).
     sample_rate : float
-        Sampling rate of the discrete gain [Hz].
+        Sampling rate of the discrete gain [Hz], in [1, 1e5].
     state_map : ndarray, optional
         ``x_design = state_map @ x_plant`` (see :func:`aeroservo.design.plant.state_map`);
         identity by default.
@@ -195,16 +245,17 @@ def lqr(
     """
     import control
 
-    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    rate = check_number(
+        "sample_rate", sample_rate, unit="Hz", lo=SAMPLE_RATES[0], hi=SAMPLE_RATES[1]
+    )
+    controls = _controls(sys, controls)
     A, B, _, _ = select(sys, controls, [])
     n = A.shape[0]
+    T = np.eye(n) if state_map is None else _state_map(state_map, n)
     Q, R, N = cost_weights(sys, controls, Q, R, bryson, "lqr")
     K, E = _balanced_lqr(control.lqr, A, B, Q, R, N)
     sp = SampledPlant.from_statespace(sys, 1.0 / rate, controls, (), [])
     Kd, _ = _balanced_lqr(control.dlqr, sp.Phi, sp.Gu, Q / rate, R / rate, N / rate)
-    T = np.eye(n) if state_map is None else np.asarray(state_map)
-    if T.shape[0] != n:
-        raise InputError(f"lqr: state_map has {T.shape[0]} rows, the design model {n} states")
     return StateFeedback(
         np.asarray(K),
         np.asarray(Kd),
@@ -214,3 +265,17 @@ def lqr(
         np.asarray(E),
         design_speed=float(getattr(sys, "speed", np.nan)),
     )
+
+
+def _state_map(value, n: int) -> np.ndarray:
+    try:
+        T = np.asarray(value)
+    except ValueError:  # ragged nesting
+        T = np.asarray(None)
+    if T.dtype.kind not in "iuf" or T.ndim != 2:
+        raise InputError(f"lqr: state_map = {describe(value)}: expected a real 2-D array")
+    if T.shape[0] != n:
+        raise InputError(f"lqr: state_map has {T.shape[0]} rows, the design model {n} states")
+    if not np.all(np.isfinite(T)):
+        raise InputError("lqr: state_map has NaN or infinite entries")
+    return T.astype(float)

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._c_stdout import c_stdout_silenced
 from .._threads import blas_limited
-from ..errors import InputError, check_int, check_number
+from ..errors import InputError, check_int, check_number, check_quantity
 from .lqg import KalmanFilter, kalman_filter, solve_dare
 from .lqr import Bryson, cost_weights
 from .plant import Limits, SampledPlant, select
@@ -286,7 +286,7 @@ def mpc(
     import casadi as ca
 
     horizon = check_int("horizon", horizon, lo=1, hi=500)
-    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    rate = check_quantity("sample_rate", sample_rate, "sample_rate")
     check_number("slack_weight", slack_weight, lo=0.0, lo_open=True)
     if solver not in SOLVERS:
         raise InputError(f"solver = {solver!r}: choose one of {sorted(SOLVERS)}")

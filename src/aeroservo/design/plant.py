@@ -19,7 +19,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import InputError, check_number
+from ..errors import RANGES, InputError, check_number
+from ..linear.models import check_continuous
+from ..linear.signals import check_names, check_signal_map, describe
+
+MAX_CUTOFF = RANGES["frequency"].hi
+"""Largest anti-aliasing filter cutoff [Hz]."""
 
 __all__ = [
     "Limits",
@@ -44,7 +49,7 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
 
 def _index(labels: Sequence[str], names: Sequence[str], what: str) -> list[int]:
     out = []
-    for n in names:
+    for n in check_names(f"{what}s", names, empty=True):
         if n not in labels:
             raise InputError(f"{what} {n!r}: not a signal of the model; it has {list(labels)}")
         out.append(list(labels).index(n))
@@ -53,6 +58,10 @@ def _index(labels: Sequence[str], names: Sequence[str], what: str) -> list[int]:
 
 def select(sys, inputs: Sequence[str], outputs: Sequence[str]) -> tuple[np.ndarray, ...]:
     """``(A, B, C, D)`` of a python-control model restricted to named inputs and outputs."""
+    import control
+
+    if not isinstance(sys, control.StateSpace):
+        raise InputError(f"sys = {describe(sys)}: expected a control.StateSpace")
     ii = _index(sys.input_labels, inputs, "input")
     oo = _index(sys.output_labels, outputs, "output")
     A = np.asarray(sys.A)
@@ -76,8 +85,7 @@ class Limits:
 
     def __post_init__(self) -> None:
         for kind in ("magnitude", "rate"):
-            for name, value in getattr(self, kind).items():
-                check_number(f"limits.{kind}[{name!r}]", value, lo=0.0, lo_open=True)
+            check_signal_map(f"limits.{kind}", getattr(self, kind))
 
     def arrays(self, controls: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
         """Magnitude and rate limits per control (inf where none)."""
@@ -127,7 +135,12 @@ class SampledPlant:
         outputs: Sequence[str] | None = None,
     ) -> SampledPlant:
         dt = check_number("sample period", dt, unit="s", lo=0.0, lo_open=True)
-        outputs = list(sys.output_labels) if outputs is None else list(outputs)
+        check_continuous("sys", sys)
+        controls = check_names("controls", controls, empty=True)
+        disturbances = check_names("disturbances", disturbances, empty=True)
+        if outputs is None:
+            outputs = list(sys.output_labels)
+        outputs = check_names("outputs", outputs, empty=True)
         A, Bu, C, Du = select(sys, controls, outputs)
         _, Bd, _, Dd = select(sys, disturbances, outputs)
         Phi, G = zoh(A, np.hstack([Bu, Bd]), dt)
@@ -196,6 +209,11 @@ def state_map(plant_builder, design_builder, *, balanced: bool = True) -> np.nda
     and servo states are shared. ``balanced`` (default, as the builders' models): between the
     scaled states of :meth:`StateSpaceBuilder.at`; False: between the physical ones.
     """
+    from ..linear.state_space import StateSpaceBuilder
+
+    for name, b in (("plant_builder", plant_builder), ("design_builder", design_builder)):
+        if not isinstance(b, StateSpaceBuilder):
+            raise InputError(f"{name} = {describe(b)}: expected a StateSpaceBuilder")
     if plant_builder.model is not design_builder.model:
         raise InputError("state_map: the builders must use the same AeroelasticModel")
     if plant_builder.n_modes is not None:
@@ -271,7 +289,7 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
     sensors : sequence of str
         Outputs to filter.
     cutoff : float
-        Cutoff frequency [Hz].
+        Cutoff frequency [Hz], in (0, 1e5].
     order : int
         Butterworth order (1 to 4).
 
@@ -282,9 +300,12 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
     """
     import control
 
-    fc = check_number("cutoff", cutoff, unit="Hz", lo=0.0, lo_open=True)
-    if order not in (1, 2, 3, 4):
-        raise InputError(f"order = {order!r}: allowed values are 1, 2, 3, 4")
+    check_continuous("sys", sys)
+    fc = check_number("cutoff", cutoff, unit="Hz", lo=0.0, lo_open=True, hi=MAX_CUTOFF)
+    is_int = isinstance(order, (int, np.integer)) and not isinstance(order, bool)
+    if not is_int or order not in (1, 2, 3, 4):
+        raise InputError(f"order = {describe(order)}: allowed values are 1, 2, 3, 4")
+    order = int(order)
     fa, fb, fc_ = _butterworth(order, fc)
     A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
     n, m = B.shape

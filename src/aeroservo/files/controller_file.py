@@ -71,8 +71,8 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
 
     if kind == "hinf":
         w = top.table("weights").check_keys(("inputs", "sensors"))
-        kw["bryson_inputs"] = w.number_map("inputs")
-        kw["sensor_scales"] = w.number_map("sensors")
+        kw["bryson_inputs"] = w.number_map("inputs", quantity="bryson")
+        kw["sensor_scales"] = w.number_map("sensors", quantity="bryson")
         for key in ("inputs", "sensors"):
             if not w.number_map(key):
                 w.fail(key, w.data[key], "give a nominal magnitude per signal")
@@ -86,6 +86,7 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
                     getattr(d, k),
                     unit="Hz" if k in ("bandwidth", "roll_off") else "",
                     lo=1.0 if k == "gamma_factor" else 0.0,
+                    hi=1e6,
                     lo_open=True,
                 )
                 for k in HINF_KEYS
@@ -96,12 +97,12 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         w = top.table("weights").check_keys(
             ("outputs", "inputs") if top.has("weights") else (), ("state_weight",)
         )
-        kw["bryson_outputs"] = w.number_map("outputs")
-        kw["bryson_inputs"] = w.number_map("inputs")
+        kw["bryson_outputs"] = w.number_map("outputs", quantity="bryson")
+        kw["bryson_inputs"] = w.number_map("inputs", quantity="bryson")
         if top.has("weights") and (not kw["bryson_outputs"] or not kw["bryson_inputs"]):
             key = "outputs" if not kw["bryson_outputs"] else "inputs"
             w.fail(key, w.data[key], "give at least one allowed value")
-        kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0)
+        kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0, hi=1.0)
     mg = top.table("margins").check_keys((), ("gain_db", "phase_deg", "disk_alpha"))
     req = MarginRequirement()
     kw["margins"] = MarginRequirement(
@@ -111,7 +112,10 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     )
 
     lim = top.table("limits").check_keys((), ("magnitude", "rate"))
-    kw["limits"] = Limits(magnitude=lim.number_map("magnitude"), rate=lim.number_map("rate"))
+    kw["limits"] = Limits(
+        magnitude=lim.number_map("magnitude", quantity="limit"),
+        rate=lim.number_map("rate", quantity="limit"),
+    )
     if kind == "mpc":
         for k in ("magnitude", "rate"):
             if not getattr(kw["limits"], k):
@@ -124,8 +128,8 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     est = top.table("estimator").check_keys(
         ("process_noise", "sensor_noise") if top.has("estimator") else ()
     )
-    kw["process_noise"] = est.number_map("process_noise")
-    kw["sensor_noise"] = est.number_map("sensor_noise")
+    kw["process_noise"] = est.number_map("process_noise", quantity="variance")
+    kw["sensor_noise"] = est.number_map("sensor_noise", quantity="variance")
     for k in ("process_noise", "sensor_noise"):
         if top.has("estimator") and not kw[k]:
             est.fail(k, est.data[k], "give at least one variance")
@@ -133,12 +137,12 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     m = top.table("mpc").check_keys((), ("horizon", "solver", "soft_outputs", "slack_weight"))
     kw["horizon"] = m.integer("horizon", 20, lo=1, hi=500)
     kw["solver"] = m.string("solver", "daqp", choices=sorted(SOLVERS))
-    kw["soft_outputs"] = m.number_map("soft_outputs")
-    kw["slack_weight"] = m.number("slack_weight", 1e4, lo=0.0, lo_open=True)
+    kw["soft_outputs"] = m.number_map("soft_outputs", quantity="limit")
+    kw["slack_weight"] = m.number("slack_weight", 1e4, lo=0.0, hi=1e12, lo_open=True)
 
     if top.has("schedule"):
         s = top.table("schedule").check_keys(("speed_factors",))
-        kw["schedule"] = tuple(s.numbers("speed_factors", lo=0.0, lo_open=True, increasing=True))
+        kw["schedule"] = tuple(s.numbers("speed_factors", quantity="speed_factor", increasing=True))
         if len(kw["schedule"]) < 2:
             s.fail("speed_factors", s.data["speed_factors"], "give at least two speeds")
     return ControllerSpec(**kw)

@@ -10,6 +10,7 @@ aeroservo version. No pickled objects: a damaged or foreign file gives one clear
 
 from __future__ import annotations
 
+import io
 import json
 import zipfile
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from .._version import __version__
 from ..errors import InputError
 from ..stability.result import Crossing, FlutterResult
 from .summaries import json_text
+from .user_files import MAX_RESULT_BYTES, read_bytes
 
 __all__ = ["FORMAT", "SavedFlutter", "flutter_writer", "read_flutter"]
 
@@ -258,26 +260,18 @@ def read_flutter(path: Path, data: dict, meta: dict) -> SavedFlutter:
 
 def open_npz(path: Path) -> tuple[dict, dict]:
     """The arrays and JSON header of an aeroservo ``.npz`` result (one clear error otherwise)."""
-    try:
-        with open(path, "rb") as fh:
-            magic = fh.read(4)
-    except (FileNotFoundError, IsADirectoryError, PermissionError):
-        magic = b"PK\x03\x04"  # reported below with the right message
-    if magic not in (b"PK\x03\x04", b"PK\x05\x06"):  # an archive (or an empty one)
+    raw = read_bytes(path, what="aeroservo result file (.npz)", limit=MAX_RESULT_BYTES)
+    if raw[:4] not in (b"PK\x03\x04", b"PK\x05\x06"):  # an archive (or an empty one)
         hint = "; a JSON summary? save a sweep with 'aeroservo flutter ... --save FILE.npz'"
         raise InputError(
             f"{path}: not an aeroservo result file (not a .npz archive"
-            + (hint if magic[:1] in (b"{", b"[") else "")
+            + (hint if raw[:1] in (b"{", b"[") else "")
             + ")"
         )
     try:
-        with np.load(path, allow_pickle=False) as npz:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
             data = {k: npz[k] for k in npz.files}
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such result file") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a folder, not a result file") from None
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as exc:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
         why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InputError(f"{path}: not an aeroservo result file ({why})") from None
     raw = data.get("meta")

@@ -77,15 +77,13 @@ def save_result(result, path: str | Path, summary: dict | None = None, **kw) -> 
 def _load_envelope(path: Path):
     """A flutter envelope saved by ``aeroservo envelope --save FILE.json``."""
     from ..studies.envelope import Envelope
+    from .user_files import read_text
 
+    text = read_text(path, what="saved envelope (JSON)")
     try:
-        if path.stat().st_size > 50_000_000:
-            raise InputError(f"{path}: larger than 50 MB; not an aeroservo envelope")
-        data = json.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such result file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{path}: not an aeroservo envelope ({exc})") from None
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise InputError(f"{path}: not an aeroservo envelope (not valid JSON: {exc})") from None
     if not isinstance(data, dict) or data.get("format") != "aeroservo-envelope-1":
         raise InputError(
             f"{path}: not a saved aeroservo result (a JSON summary? save a sweep with "
@@ -103,8 +101,9 @@ def load_result(path: str | Path):
     :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep, a trade study's
     folder (``TradeResult``) or a flutter envelope saved as JSON (``Envelope``)."""
     from .flutter_file import FORMAT, open_npz, read_flutter
+    from .user_files import user_path
 
-    path = Path(path)
+    path = user_path(path, "result file")
     if path.is_dir():
         from ..studies.trade.results import load_trade
 
@@ -133,6 +132,11 @@ def load_result(path: str | Path):
         for name, y in sig.items():
             if y.dtype.kind not in "fiub" or y.shape[:1] != t.shape:
                 raise InputError(f"{path}: signal {g}.{name} does not match the {t.size} times")
+    if set(groups["commands"]) != set(groups["applied"]) or not groups["outputs"]:
+        raise InputError(
+            f"{path}: simulation result without matching commands and applied controls "
+            f"({sorted(groups['commands'])} vs {sorted(groups['applied'])}) or without outputs"
+        )
     try:
         return SimulationResult(
             t=t,

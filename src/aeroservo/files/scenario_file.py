@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import MAX_ELEMENTS, InputError
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .scenario_checks import cross_check
@@ -96,6 +96,11 @@ def _wing(tbl: Table, base: Path):
         raise InputError(f"{tbl.file}: {msg}") from None
 
 
+MAX_RESULT_NAME = 200
+"""Longest result stem [bytes]: its longest file, ``<result>_margin_sweep.png``, and the
+temporary name it is written under stay within the usual 255-byte file-name limit."""
+
+
 def scenario_from_dict(data: object, file: str = "<dict>", base: Path | None = None) -> Scenario:
     """Validate a parsed scenario file. ``base`` is the folder relative paths start from."""
     with one_line_errors():
@@ -129,8 +134,8 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     flight(fl, kw)
     if fl.has("speed") and fl.has("speed_factor"):
         fl.fail("speed_factor", fl.data["speed_factor"], "give speed or speed_factor, not both")
-    kw["speed"] = fl.number("speed", unit="m/s", lo=0.0, hi=1000.0, lo_open=True)
-    kw["speed_factor"] = fl.number("speed_factor", lo=0.0, hi=10.0, lo_open=True)
+    kw["speed"] = fl.number("speed", quantity="flight_speed")
+    kw["speed_factor"] = fl.number("speed_factor", quantity="speed_factor")
     if kind == "simulate" and kw["speed"] is None and kw["speed_factor"] is None:
         raise InputError(f"{file}: flight.speed: missing; give speed [m/s] or speed_factor")
 
@@ -155,7 +160,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
             raise InputError(f"{file}: {exc}") from None
     elif wing_damping is not None:
         kw["damping"] = wing_damping
-    kw["elements"] = md.integer("elements", 10, lo=1, hi=400)
+    kw["elements"] = md.integer("elements", 10, lo=1, hi=MAX_ELEMENTS)
     try:
         build_mesh(wing, kw["elements"])
     except InputError as exc:  # too few elements for the wing's breakpoints
@@ -169,7 +174,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     modes = md.integer("design_modes", 8, lo=0, hi=10_000)
     kw["design_modes"] = None if modes == 0 else modes
     kw["gust_model"] = md.string("gust", "kussner", choices=("kussner", "upwash"))
-    kw["v_max"] = md.number("v_max", unit="m/s", lo=0.0, lo_open=True)
+    kw["v_max"] = md.number("v_max", quantity="flight_speed")
     kw["pk"] = md.boolean("pk", False)
 
     sg = top.table("signals").check_keys(
@@ -180,7 +185,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["controls"] = tuple(sg.strings("controls", default_controls))
     kw["sensors"] = tuple(sg.strings("sensors", ["tip_le_accel", "tip_te_accel", "tip_twist"]))
     kw["outputs"] = tuple(sg.strings("outputs", ["tip_disp"], nonempty=False))
-    cutoff = sg.number("sensor_filter", 30.0, unit="Hz", lo=0.0)
+    cutoff = sg.number("sensor_filter", 30.0, quantity="frequency")
     kw["sensor_filter"] = None if cutoff == 0 else cutoff
     kw["filter_order"] = sg.integer("filter_order", 2, lo=1, hi=4)
 
@@ -188,11 +193,11 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         (), ("duration", "sample_rate", "delay", "seed", "sensor_noise", "expect_unstable")
     )
     kw["expect_unstable"] = sim.boolean("expect_unstable", False)
-    kw["duration"] = sim.number("duration", 2.0, unit="s", lo=0.0, hi=600.0, lo_open=True)
-    kw["sample_rate"] = sim.number("sample_rate", 1000.0, unit="Hz", lo=1.0, hi=1.0e5)
+    kw["duration"] = sim.number("duration", 2.0, quantity="duration")
+    kw["sample_rate"] = sim.number("sample_rate", 1000.0, quantity="sample_rate")
     kw["delay"] = sim.boolean("delay", False)
     kw["seed"] = sim.integer("seed", 0, lo=0, hi=2**32 - 1)
-    kw["sensor_noise"] = sim.number_map("sensor_noise", lo=0.0, lo_open=False)
+    kw["sensor_noise"] = sim.number_map("sensor_noise", quantity="variance")
 
     an = top.table("analysis").check_keys(
         (), ("closed_loop_boundary", "v_max_factor", "n_grid", "margin_speeds")
@@ -208,6 +213,12 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     result = kw["result"]
     if result in ("", ".", "..") or Path(result).name != result or not result.isprintable():
         out.fail("result", kw["result"], "expected a plain file name stem (no folders)")
+    if len(result.encode()) > MAX_RESULT_NAME:
+        out.fail(
+            "result",
+            result[:40] + "...",
+            f"{len(result.encode())} bytes; at most {MAX_RESULT_NAME} (file-name limit)",
+        )
     kw["plots"] = out.boolean("plots", True)
 
     if kind == "simulate":

@@ -4,6 +4,7 @@ a gust series from a CSV file) and the trade study (see :mod:`aeroservo.files.sc
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from ..errors import InputError
 from ..studies.scenario import GUST_KEYS, GUST_TYPES, Disturbance
 from .controller_file import load_controller
 from .toml_tables import Table
+from .user_files import read_text
 
 __all__ = ["flight", "disturbance", "trade_table", "controller", "is_file"]
 
@@ -27,14 +29,14 @@ def disturbance(tbl: Table, base: Path, span: float) -> Disturbance:
     gust = None
     if kind == "one_minus_cosine":
         gust = OneMinusCosine(
-            length=tbl.number("length", unit="m", lo=0.0, lo_open=True, required=True),
-            amplitude=tbl.number("amplitude", unit="m/s", lo=-50.0, hi=50.0, required=True),
-            start=tbl.number("start", 0.0, unit="s", lo=0.0),
+            length=tbl.number("length", quantity="gust_length", required=True),
+            amplitude=tbl.number("amplitude", quantity="gust_velocity", required=True),
+            start=tbl.number("start", 0.0, quantity="time"),
         )
     elif kind == "turbulence":
         gust = Turbulence(
             sigma=tbl.number("sigma", unit="m/s", lo=0.0, hi=30.0, required=True),
-            scale=tbl.number("scale", 533.0, unit="m", lo=0.0, lo_open=True),
+            scale=tbl.number("scale", 533.0, quantity="gust_length"),
             model=tbl.string("model", "von_karman", choices=("von_karman", "dryden")),
             seed=tbl.integer("seed", 0, lo=0, hi=2**32 - 1),
         )
@@ -44,28 +46,35 @@ def disturbance(tbl: Table, base: Path, span: float) -> Disturbance:
     return Disturbance(initial_tip=tip, gust=gust)
 
 
+PARAMETER_QUANTITIES = {
+    "hinge_stiffness": "hinge_stiffness",
+    "bryson_hinge_moment": "bryson",
+    "speed_factor": "speed_factor",
+}
+"""Trade parameters that are physical quantities (the others are fractions)."""
+
+
 def gust_series(tbl: Table, path: Path, cls):
     """CSV with columns time [s], velocity [m/s] (a header line is allowed)."""
     if not is_file(path):
         tbl.fail("file", tbl.data["file"], f"no such gust file ({path})")
+    try:
+        text = read_text(path, what="gust series (CSV: time, velocity)")
+    except InputError as exc:
+        tbl.fail("file", tbl.data["file"], str(exc))
     rows = []
     try:
-        with path.open(newline="", encoding="utf-8") as fh:
-            for i, row in enumerate(csv.reader(fh)):
-                if not row or row[0].strip().startswith("#"):
-                    continue
-                try:
-                    rows.append((float(row[0]), float(row[1])))
-                except (ValueError, IndexError):
-                    if i == 0:
-                        continue  # header
-                    tbl.fail("file", tbl.data["file"], f"line {i + 1}: expected time, velocity")
-    except UnicodeDecodeError:
-        tbl.fail("file", tbl.data["file"], "not a UTF-8 text file")
+        for i, row in enumerate(csv.reader(io.StringIO(text, newline=""))):
+            if not row or row[0].strip().startswith("#"):
+                continue
+            try:
+                rows.append((float(row[0]), float(row[1])))
+            except (ValueError, IndexError):
+                if i == 0:
+                    continue  # header
+                tbl.fail("file", tbl.data["file"], f"line {i + 1}: expected time, velocity")
     except csv.Error as exc:
         tbl.fail("file", tbl.data["file"], f"not a CSV file: {exc}")
-    except OSError as exc:
-        tbl.fail("file", tbl.data["file"], f"cannot read the gust file: {exc.strerror}")
     t = np.array([r[0] for r in rows])
     w = np.array([r[1] for r in rows])
     try:
@@ -85,7 +94,7 @@ def flight(fl: Table, kw: dict) -> None:
         fl.fail(given[1], fl.data[given[1]], "give one of density, altitude, altitude_ft")
     kw["altitude"] = None
     if given[0] == "density":
-        kw["density"] = fl.number("density", unit="kg/m^3", lo=0.0, hi=2.0, lo_open=True)
+        kw["density"] = fl.number("density", quantity="density")
     else:
         ft = given[0] == "altitude_ft"
         lo, hi = ALTITUDE_RANGE
@@ -122,7 +131,11 @@ def trade_table(tbl: Table, base: Path) -> dict:
     pt = tbl.table("parameters").check_keys((), tuple(PARAMETERS))
     params = {}
     for name in pt.data:
-        params[name] = tuple(pt.numbers(name, lo=0.0, lo_open=name != "hinge_stiffness"))
+        if name in PARAMETER_QUANTITIES:
+            values = pt.numbers(name, quantity=PARAMETER_QUANTITIES[name])
+        else:  # fractions of the span or of the chord: the study checks their ranges
+            values = pt.numbers(name, lo=0.0, lo_open=True)
+        params[name] = tuple(values)
         if len(set(params[name])) != len(params[name]):
             pt.fail(name, pt.data[name], "values must not repeat")
     if not params:
@@ -133,9 +146,9 @@ def trade_table(tbl: Table, base: Path) -> dict:
     return {
         "controller": spec,
         "parameters": params,
-        "speed_factor": tbl.number("speed_factor", 1.1, lo=0.0, hi=10.0, lo_open=True),
-        "gust_length": tbl.number("gust_length", 25.0, unit="m", lo=0.0, lo_open=True),
-        "gust_amplitude": tbl.number("gust_amplitude", 5.0, unit="m/s", lo=-50.0, hi=50.0),
+        "speed_factor": tbl.number("speed_factor", 1.1, quantity="speed_factor"),
+        "gust_length": tbl.number("gust_length", 25.0, quantity="gust_length"),
+        "gust_amplitude": tbl.number("gust_amplitude", 5.0, quantity="gust_velocity"),
         "gust_duration": tbl.number("gust_duration", 1.0, unit="s", lo=0.0, hi=60.0, lo_open=True),
         "v_max_factor": tbl.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True),
         "n_grid": tbl.integer("n_grid", 21, lo=3, hi=2000),

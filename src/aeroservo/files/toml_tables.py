@@ -15,7 +15,8 @@ from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import RANGES, InputError, show_value
+from .user_files import read_text, user_path
 
 __all__ = ["Table", "read_toml", "check_integers", "one_line", "one_line_errors"]
 
@@ -41,26 +42,20 @@ def one_line_errors() -> Iterator[None]:
         raise InputError(message) from None
 
 
-def read_toml(path: str | Path) -> dict:
-    """Parse a TOML file; a missing file or bad syntax is an :class:`InputError`."""
-    path = Path(path)
+def read_toml(path: str | Path, what: str = "TOML file") -> dict:
+    """Parse a TOML file read by :func:`~aeroservo.files.user_files.read_text`; a missing
+    file, a file that is not UTF-8 text or bad syntax is an :class:`InputError`."""
+    path = user_path(path, what)
+    text = read_text(path, what=what)
     try:
-        with path.open("rb") as fh:
-            raw = fh.read()
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a folder, expected a TOML file") from None
-    except (OSError, ValueError) as exc:  # unreadable, name too long, embedded NUL, ...
-        raise InputError(f"{path}: cannot read the file: {exc}") from None
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
-    except ValueError as exc:  # an integer literal of more than 4300 digits
-        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except ValueError:  # an integer literal of more than 4300 digits
+        raise InputError(
+            f"{path}: not valid TOML: an integer of more than 4300 digits (TOML integers are "
+            "64-bit)"
+        ) from None
     except RecursionError:
         raise InputError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
     check_integers(data, str(path))
@@ -78,8 +73,8 @@ def check_integers(data: object, file: str, where: str = "") -> None:
     elif isinstance(data, int) and not isinstance(data, bool):
         if not INT64[0] <= data <= INT64[1]:
             raise InputError(
-                f"{file}: {where or '(top level)'} = {_show(data)}: integer outside the 64-bit "
-                f"range of TOML [{INT64[0]}, {INT64[1]}]"
+                f"{file}: {where or '(top level)'} = {show_value(data)}: integer outside the "
+                f"64-bit range of TOML [{INT64[0]}, {INT64[1]}]"
             )
 
 
@@ -91,14 +86,6 @@ def _key(key: object) -> str:
     if isinstance(key, str) and _BARE_KEY.fullmatch(key):
         return key
     return json.dumps(key) if isinstance(key, str) else repr(key)
-
-
-def _show(value: object) -> str:
-    try:
-        text = repr(value)
-    except ValueError:  # an integer too long to print
-        text = f"<{type(value).__name__} too long to show>"
-    return text if len(text) <= 80 else text[:77] + "..."
 
 
 class Table:
@@ -129,7 +116,7 @@ class Table:
 
     def fail(self, key: str | None, value: object, what: str):
         """Raise the error for ``key`` (None: the table itself) with value and explanation."""
-        raise InputError(f"{self.file}: {self.key_name(key)} = {_show(value)}: {what}")
+        raise InputError(f"{self.file}: {self.key_name(key)} = {show_value(value)}: {what}")
 
     # -- structure ----------------------------------------------------------------------
     def check_keys(self, required: Sequence[str] = (), optional: Sequence[str] = ()) -> Table:
@@ -166,12 +153,16 @@ class Table:
         lo_open: bool = False,
         hi_open: bool = False,
         required: bool = False,
+        quantity: str | None = None,
     ) -> float | None:
-        """A finite real number within bounds (integers accepted)."""
+        """A finite real number within bounds (integers accepted); ``quantity``: the bounds
+        and unit of that entry of :data:`aeroservo.errors.RANGES`."""
         if key not in self.data:
             if required:
                 raise InputError(f"{self.file}: {self.key_name(key)}: missing required key")
             return default
+        if quantity is not None:
+            unit, lo, hi, lo_open, hi_open = _bounds(quantity)
         return self.check_value(key, self.data[key], unit, lo, hi, lo_open, hi_open)
 
     def check_value(self, key, v, unit="", lo=None, hi=None, lo_open=False, hi_open=False):
@@ -261,20 +252,33 @@ class Table:
         hi=None,
         lo_open=False,
         increasing: bool = False,
+        quantity: str | None = None,
     ) -> list | None:
-        """A non-empty list of numbers, each within bounds."""
+        """A non-empty list of numbers, each within bounds (or ``quantity``'s range)."""
+        hi_open = False
+        if quantity is not None:
+            unit, lo, hi, lo_open, hi_open = _bounds(quantity)
         if key not in self.data:
             return default
         v = self.data[key]
         if not isinstance(v, list) or not v:
             self.fail(key, v, f"expected a non-empty list of numbers{f' [{unit}]' if unit else ''}")
-        out = [self.check_value(f"{key}[{i}]", x, unit, lo, hi, lo_open) for i, x in enumerate(v)]
+        out = [
+            self.check_value(f"{key}[{i}]", x, unit, lo, hi, lo_open, hi_open)
+            for i, x in enumerate(v)
+        ]
         if increasing and any(b <= a for a, b in zip(out[:-1], out[1:], strict=True)):
             self.fail(key, v, "values must increase")
         return out
 
-    def number_map(self, key: str, *, unit: str = "", lo=0.0, lo_open=True) -> dict:
-        """An inline table ``{name = number}`` (e.g. limits or noise levels by signal)."""
+    def number_map(
+        self, key: str, *, unit: str = "", lo=0.0, lo_open=True, quantity: str | None = None
+    ) -> dict:
+        """An inline table ``{name = number}`` (e.g. limits or noise levels by signal), each
+        value within ``[lo, inf)`` or within ``quantity``'s range."""
+        hi = hi_open = None
+        if quantity is not None:
+            unit, lo, hi, lo_open, hi_open = _bounds(quantity)
         if key not in self.data:
             return {}
         sub = self.table(key)
@@ -282,7 +286,7 @@ class Table:
             if not isinstance(name, str) or not name.isidentifier():
                 sub.fail(name, val, "not a signal name (letters, digits and underscores)")
         return {
-            name: sub.check_value(name, val, unit, lo, None, lo_open)
+            name: sub.check_value(name, val, unit, lo, hi, lo_open, bool(hi_open))
             for name, val in sub.data.items()
         }
 
@@ -295,6 +299,11 @@ class Table:
             self.fail(key, s, "expected a file path")
         p = Path(s)
         return p if p.is_absolute() else base / p
+
+
+def _bounds(quantity: str) -> tuple:
+    r = RANGES[quantity]
+    return r.unit, r.lo, r.hi, r.lo_open, r.hi_open
 
 
 def is_scenario_file(path: str | Path) -> bool:

@@ -10,17 +10,17 @@ the key and the value.
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..aero.atmosphere import isa, isa_ft
 from ..aero.indicial import wagner_set
-from ..errors import InputError, check_int, check_number
+from ..errors import MAX_ELEMENTS, InputError, check_int, check_number, check_quantity
 from ..stability.matched import COMPRESSIBILITY
 from ..structure.wing import Actuator, ControlSurface, Segment, Wing
 from ..system.damping import NO_DAMPING, StructuralDamping
+from .toml_tables import read_toml
 
 __all__ = [
     "AnalysisOptions",
@@ -153,9 +153,7 @@ def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOption
             f"{where}.{given[1]} = {tbl[given[1]]!r}: give one of density, altitude, altitude_ft"
         )
     if "density" in tbl:
-        opts["density"] = check_number(
-            f"{where}.density", tbl["density"], unit="kg/m^3", lo=0.0, lo_open=True
-        )
+        opts["density"] = check_quantity(f"{where}.density", tbl["density"], "density")
     if "altitude" in tbl or "altitude_ft" in tbl:
         key = given[0]
         try:
@@ -176,14 +174,16 @@ def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOption
             )
         opts["compressibility"] = None if comp == "none" else comp
     if "elements" in tbl:
-        opts["elements"] = check_int(f"{where}.elements", tbl["elements"], lo=1, hi=100_000)
+        opts["elements"] = check_int(f"{where}.elements", tbl["elements"], lo=1, hi=MAX_ELEMENTS)
     if "wagner" in tbl:
-        wagner_set(tbl["wagner"])
+        try:
+            wagner_set(tbl["wagner"])
+        except InputError as exc:
+            msg = str(exc)
+            raise InputError(f"{where}.{msg}" if msg.startswith("wagner") else msg) from None
         opts["wagner"] = tbl["wagner"]
     if "v_max" in tbl:
-        opts["v_max"] = check_number(
-            f"{where}.v_max", tbl["v_max"], unit="m/s", lo=0.0, lo_open=True
-        )
+        opts["v_max"] = check_quantity(f"{where}.v_max", tbl["v_max"], "flight_speed")
     if "n_modes" in tbl:
         opts["n_modes"] = check_int(f"{where}.n_modes", tbl["n_modes"], lo=1)
     return AnalysisOptions(**opts)
@@ -227,14 +227,8 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
     InputError
         With the file name, the key and the value of the first problem found.
     """
+    data = read_toml(path, "wing file (TOML)")
     path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML: {exc}") from None
     try:
         _check_keys("(top level)", data, ("wing",), ("analysis", "damping"))
         opts = analysis_from_dict(data.get("analysis", {}))

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import InputError, check_number
-from .signals import Sensor
-from .state_space import Servo, StateSpaceBuilder, _tag
+from ..errors import RANGES, InputError, check_number
+from .signals import Sensor, describe
+from .state_space import DENSITIES, MAX_SPEED, Servo, StateSpaceBuilder, _tag
 
 __all__ = ["statespace", "statespace_family", "discretize", "tip_deflection_state"]
 
@@ -18,11 +18,22 @@ __all__ = ["statespace", "statespace_family", "discretize", "tip_deflection_stat
 _MODELS: dict = {}
 
 
+SAMPLE_RATES = (RANGES["sample_rate"].lo, RANGES["sample_rate"].hi)
+"""Allowed sample rates [Hz] of sampled models (as in scenario files)."""
+
+_BUILDER_KW = ("servo", "gust", "kussner", "n_modes", "mach")
+
+
 def _model_for(wing_or_model, n_elements: int, wagner: object):
+    from ..structure.wing import Wing
     from ..system.aeroelastic import AeroelasticModel
 
     if isinstance(wing_or_model, AeroelasticModel):
         return wing_or_model
+    if not isinstance(wing_or_model, Wing):
+        raise InputError(
+            f"wing = {describe(wing_or_model)}: expected an aeroservo.Wing or an AeroelasticModel"
+        )
     key = (wing_or_model, n_elements, wagner if isinstance(wagner, str) else None)
     if key[2] is not None and key in _MODELS:
         return _MODELS[key]
@@ -35,6 +46,7 @@ def _model_for(wing_or_model, n_elements: int, wagner: object):
 
 
 def _builder_for(model, density, inputs, outputs, **kw) -> StateSpaceBuilder:
+    check_number("density", density, unit="kg/m^3", lo=DENSITIES[0], hi=DENSITIES[1])
     cache = model.__dict__.setdefault("_ss_builders", {})
     try:
         key = (float(density), _freeze(inputs), _freeze(outputs), _freeze(kw))
@@ -95,6 +107,8 @@ def statespace(
         With named states, inputs and outputs, and attributes ``speed``, ``density`` and
         ``signal_units``. Builders are cached per model, so repeated calls are cheap.
     """
+    check_number("speed", speed, unit="m/s", lo=0.0, hi=MAX_SPEED)
+    _check_bool("balanced", balanced)
     model = _model_for(wing, n_elements, wagner)
     b = _builder_for(
         model, density, inputs, outputs, servo=servo, gust=gust, kussner=kussner, n_modes=n_modes
@@ -111,14 +125,23 @@ def statespace_family(
     """
     n_el = kw.pop("n_elements", 10)
     wag = kw.pop("wagner", "rt_jones")
-    balanced = kw.pop("balanced", True)
+    balanced = _check_bool("balanced", kw.pop("balanced", True))
+    for k in kw:
+        if k not in _BUILDER_KW:
+            allowed = ["n_elements", "wagner", "balanced", *_BUILDER_KW]
+            raise InputError(f"statespace_family: unknown argument {k!r}; allowed: {allowed}")
+    if not (isinstance(speeds, (list, tuple, range)) or getattr(speeds, "ndim", 0) == 1):
+        raise InputError(f"speeds = {describe(speeds)}: expected a sequence of speeds [m/s]")
     model = _model_for(wing, n_el, wag)
     return _builder_for(model, density, inputs, outputs, **kw).family(speeds, balanced=balanced)
 
 
 def discretize(sys, sample_rate: float):
-    """Zero-order-hold discretization at ``sample_rate`` [Hz]; names and tags are kept."""
-    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
+    """Zero-order-hold discretization at ``sample_rate`` [Hz] (1 Hz to 100 kHz); names and tags
+    are kept."""
+    check_continuous("sys", sys)
+    lo, hi = SAMPLE_RATES
+    rate = check_number("sample_rate", sample_rate, unit="Hz", lo=lo, hi=hi)
     d = sys.sample(1.0 / rate, method="zoh")
     if hasattr(sys, "speed"):
         _tag(d, sys.speed, sys.density, sys.signal_units)
@@ -134,7 +157,10 @@ def tip_deflection_state(builder, tip: float, *, balanced: bool = True) -> np.nd
     :class:`~aeroservo.linear.state_space.StateSpaceBuilder` (full model); ``balanced``
     (default, as its models): in the scaled states of ``builder.at``; False: physical states.
     """
+    if not isinstance(builder, StateSpaceBuilder):
+        raise InputError(f"builder = {describe(builder)}: expected a StateSpaceBuilder")
     check_number("tip", tip, unit="m")
+    _check_bool("balanced", balanced)
     if builder.n_modes is not None:
         raise InputError("tip_deflection_state: use the full-model builder of the plant")
     model = builder.model
@@ -144,3 +170,21 @@ def tip_deflection_state(builder, tip: float, *, balanced: bool = True) -> np.nd
     x = np.zeros(builder.n_states)
     x[: model.n_dofs] = q * (tip / q[model.mesh.dof_w[-1]])
     return x / builder.state_scaling if balanced else x
+
+
+def _check_bool(field: str, value: object) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{field} = {describe(value)}: expected True or False")
+    return bool(value)
+
+
+def check_continuous(field: str, sys: object) -> None:
+    """Refuse anything but a continuous-time ``control.StateSpace``."""
+    import control
+
+    if not isinstance(sys, control.StateSpace):
+        raise InputError(f"{field} = {describe(sys)}: expected a control.StateSpace")
+    if sys.isdtime(strict=True):
+        raise InputError(
+            f"{field}: a discrete-time model (dt = {sys.dt}); expected a continuous one"
+        )

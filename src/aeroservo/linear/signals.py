@@ -27,14 +27,26 @@ Outputs (by name, or :class:`Sensor` for any point):
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError, check_number
+from ..errors import show_value as describe
 from ..structure.beam_element import point_shapes
 
-__all__ = ["Sensor", "DEFAULT_OUTPUTS", "input_names", "output_units", "InputDef", "OutputDef"]
+__all__ = [
+    "Sensor",
+    "DEFAULT_OUTPUTS",
+    "check_names",
+    "check_signal_map",
+    "describe",
+    "input_names",
+    "output_units",
+    "InputDef",
+    "OutputDef",
+]
 
 DEFAULT_OUTPUTS = ("tip_le_accel", "tip_te_accel", "tip_twist")
 """Outputs used when none are given: tip accelerometers at both edges and tip twist."""
@@ -73,7 +85,9 @@ class Sensor:
     chord: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.quantity not in QUANTITIES:
+        if not isinstance(self.name, str) or not self.name:
+            raise InputError(f"sensor.name = {self.name!r}: expected a non-empty string")
+        if not isinstance(self.quantity, str) or self.quantity not in QUANTITIES:
             raise InputError(
                 f"sensor '{self.name}'.quantity = {self.quantity!r}: expected one of "
                 f"{sorted(QUANTITIES)}"
@@ -113,12 +127,51 @@ def input_names(wing) -> dict[str, InputDef]:
     return out
 
 
+def check_signal_map(
+    field: str, value: object, *, lo: float = 0.0, hi: float | None = None, lo_open: bool = True
+) -> dict:
+    """A mapping ``{signal name: number}`` (limits, Bryson values, noise levels), each value
+    finite and within ``[lo, hi]`` (``lo`` excluded if ``lo_open``) [signal units]."""
+    if not isinstance(value, Mapping):
+        raise InputError(
+            f"{field} = {describe(value)}: expected a mapping of signal name -> number, e.g. "
+            "{'tip_disp': 0.05}"
+        )
+    for name, v in value.items():
+        if not isinstance(name, str):
+            raise InputError(f"{field}: key {describe(name)} is not a signal name")
+        check_number(f"{field}[{name!r}]", v, unit="signal units", lo=lo, hi=hi, lo_open=lo_open)
+    return dict(value)
+
+
+def check_names(field: str, value: object, *, items=(str,), empty: bool = False) -> list:
+    """A list of signal names (a list, tuple or 1-D array; not a bare string), as a list.
+
+    ``items`` are the accepted types of the entries; ``empty``: whether ``[]`` is allowed.
+    """
+    if isinstance(value, str):
+        raise InputError(
+            f"{field} = {describe(value)}: expected a list of signal names, not a bare string "
+            f"(pass [{value!r}])"
+        )
+    if isinstance(value, np.ndarray) and value.ndim == 1:
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)):
+        raise InputError(f"{field} = {describe(value)}: expected a list of signal names")
+    if not value and not empty:
+        raise InputError(f"{field} = {value!r}: give at least one signal name")
+    for i, v in enumerate(value):
+        if not isinstance(v, items) or (isinstance(v, str) and not v):
+            what = "a signal name" if items == (str,) else "a signal name or an aeroservo.Sensor"
+            raise InputError(f"{field}[{i}] = {describe(v)}: expected {what}")
+    return list(value)
+
+
 def resolve_inputs(wing, names) -> list[InputDef]:
     table = input_names(wing)
     if names is None:
         names = [n for n, d in table.items() if d.kind in ("hinge_moment", "gust")]
-    if isinstance(names, str):
-        names = [names]
+    names = check_names("inputs", names)
     out = []
     for n in names:
         if n not in table:
@@ -142,8 +195,9 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
     wing = model.wing
     if specs is None:
         specs = DEFAULT_OUTPUTS
-    if isinstance(specs, (str, Sensor)):
+    if isinstance(specs, Sensor):
         specs = [specs]
+    specs = check_names("outputs", specs, items=(str, Sensor))
     surfaces = {cs.name: k for k, cs in enumerate(wing.control_surfaces)}
     out = []
     for spec in specs:

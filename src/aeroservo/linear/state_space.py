@@ -22,13 +22,14 @@ import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..aero.indicial import IndicialSet, kussner_set
-from ..errors import InputError, check_number
+from ..errors import RANGES, InputError, check_int, check_number
 from ..system.first_order import check_mach, compressibility_factors, first_order
 from .polynomial import _dense, _Poly
 from .servo import Servo, servos_of
 from .signals import (
     Sensor,
     actuator_rows,
+    describe,
     hinge_moment_vector,
     output_units,
     resolve_inputs,
@@ -38,7 +39,13 @@ from .signals import (
     surface_unit,
 )
 
-__all__ = ["Servo", "StateSpaceBuilder"]
+__all__ = ["Servo", "StateSpaceBuilder", "MAX_SPEED", "DENSITIES"]
+
+MAX_SPEED = RANGES["airspeed"].hi
+"""Largest airspeed [m/s] of a state-space model."""
+DENSITIES = (RANGES["density"].lo, RANGES["density"].hi)
+"""Allowed air densities [kg/m^3] of a state-space model."""
+MAX_FAMILY_BYTES = 1 << 30  # largest memory [bytes] of the matrices of a family of models
 
 
 class StateSpaceBuilder:
@@ -89,15 +96,23 @@ class StateSpaceBuilder:
         n_modes: int | None = None,
         mach: float = 0.0,
     ):
+        from ..system.aeroelastic import AeroelasticModel
+
+        if not isinstance(model, AeroelasticModel):
+            raise InputError(f"model = {describe(model)}: expected an aeroservo.AeroelasticModel")
         self.model = model
-        self.density = rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-        if gust not in ("kussner", "upwash"):
-            raise InputError(f"gust = {gust!r}: allowed values are 'kussner' and 'upwash'")
+        self.density = rho = check_number(
+            "density", density, unit="kg/m^3", lo=DENSITIES[0], hi=DENSITIES[1]
+        )
+        if not isinstance(gust, str) or gust not in ("kussner", "upwash"):
+            raise InputError(f"gust = {describe(gust)}: allowed values are 'kussner' and 'upwash'")
         self.gust = gust
         self.kussner: IndicialSet = kussner_set(kussner)
         wing = model.wing
         self.inputs = resolve_inputs(wing, inputs)
         n_avail = model.n_dofs
+        if n_modes is not None:
+            n_modes = check_int("n_modes", n_modes, lo=1, hi=n_avail)
         self.outputs = resolve_outputs(model, outputs, n_avail)
         self.servos = servos_of(wing, servo, self.inputs)
 
@@ -106,7 +121,6 @@ class StateSpaceBuilder:
         n_need = max([n_modes or 0] + [o.index + 1 for o in self.outputs if o.kind == "modal"])
         modes = model.natural_modes(n_need) if n_need else None
         if n_modes is not None:
-            n_modes = min(int(n_modes), n_avail)
             am = am.project(modes.shapes[:, :n_modes])
             basis = modes.shapes[:, :n_modes]
         else:
@@ -285,7 +299,7 @@ class StateSpaceBuilder:
 
     def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(A, B, C, D)`` at ``speed`` [m/s]."""
-        v = check_number("speed", speed, unit="m/s", lo=0.0)
+        v = check_number("speed", speed, unit="m/s", lo=0.0, hi=MAX_SPEED)
         return self._A(v), self._B(v), self._C(v), self._D(v)
 
     @property
@@ -326,6 +340,8 @@ class StateSpaceBuilder:
         """
         import control
 
+        if not isinstance(balanced, (bool, np.bool_)):
+            raise InputError(f"balanced = {describe(balanced)}: expected True or False")
         A, B, C, D = self.matrices(speed)
         s = self.state_scaling if balanced else np.ones(A.shape[0])
         if balanced:
@@ -348,7 +364,22 @@ class StateSpaceBuilder:
 
     def family(self, speeds: Sequence[float], *, balanced: bool = True) -> list:
         """Models at every speed of a grid [m/s] (no re-assembly; one state scaling)."""
-        return [self.at(v, balanced=balanced) for v in speeds]
+        if not (isinstance(speeds, (list, tuple, range)) or getattr(speeds, "ndim", 0) == 1):
+            raise InputError(f"speeds = {describe(speeds)}: expected a sequence of speeds [m/s]")
+        if len(speeds) == 0:
+            raise InputError("speeds = []: give at least one speed [m/s]")
+        n, k = self.n_states, len(speeds)
+        gib = 8 * k * (n + len(self.outputs)) * (n + len(self.inputs)) / 2**30
+        if gib > MAX_FAMILY_BYTES / 2**30:
+            raise InputError(
+                f"speeds: {k} models of {n} states need {gib:.3g} GiB, above the limit of "
+                f"{MAX_FAMILY_BYTES / 2**30:g} GiB; use fewer speeds"
+            )
+        vs = [
+            check_number(f"speeds[{i}]", v, unit="m/s", lo=0.0, hi=MAX_SPEED)
+            for i, v in enumerate(speeds)
+        ]
+        return [self.at(v, balanced=balanced) for v in vs]
 
 
 def _system_name(wing_name: str, speed: float) -> str:

@@ -10,16 +10,26 @@ An optional computational delay applies each command one sample late.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from .._threads import blas_limited
 from ..design.plant import Limits, SampledPlant
 from ..errors import InputError, check_int, check_number
+from ..linear.models import SAMPLE_RATES, check_continuous
+from ..linear.signals import check_names, describe
 from .result import SimulationResult
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "MAX_SAMPLES", "MAX_BYTES"]
+
+MAX_SAMPLES = 10_000_000
+"""Most samples of one simulation (duration x sample rate of the controller)."""
+MAX_BYTES = 1 << 30
+"""Largest memory [bytes] of the recorded arrays of one simulation (1 GiB)."""
+
+_PROTOCOL = ("dt", "controls", "reset", "command", "update")
+"""Attributes of a sampled controller."""
 
 
 @blas_limited
@@ -48,7 +58,7 @@ def simulate(
         Sampled controller (its ``dt`` sets the sample period); a gain schedule is evaluated
         at the plant's speed; :class:`aeroservo.design.OpenLoop` runs the open loop.
     duration : float
-        [s].
+        [s]; at most :data:`MAX_SAMPLES` samples, and :data:`MAX_BYTES` of recorded arrays.
     x0 : ndarray, optional
         Initial plant state (default zero).
     disturbance : callable, optional
@@ -59,7 +69,7 @@ def simulate(
         One-sample computational delay.
     sensor_noise : dict, optional
         ``{sensor: standard deviation}`` added to the measurements the controller reads
-        (seeded).
+        (seeded); names are outputs of the plant, values finite and >= 0.
     seed : int
         Seed of the sensor noise.
     record_states : bool
@@ -71,29 +81,50 @@ def simulate(
     -------
     SimulationResult
     """
+    check_continuous("plant", plant)
     if hasattr(controller, "at"):  # a gain schedule: the controller at the plant's speed
         controller = controller.at(float(getattr(plant, "speed", np.nan)))
-    dt = check_number("controller.dt", controller.dt, unit="s", lo=0.0, lo_open=True)
+    if not all(hasattr(controller, a) for a in _PROTOCOL):
+        raise InputError(
+            f"controller = {describe(controller)}: expected a sampled controller (StateFeedback, "
+            "OutputFeedback, GainSchedule, MPCController or OpenLoop)"
+        )
+    lo, hi = SAMPLE_RATES
+    dt = check_number("controller.dt", controller.dt, unit="s", lo=1.0 / hi, hi=1.0 / lo)
     duration = check_number("duration", duration, unit="s", lo=0.0, lo_open=True)
     check_int("seed", seed, lo=0)
+    for name, flag in (("delay", delay), ("record_states", record_states)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise InputError(f"{name} = {describe(flag)}: expected True or False")
+    if disturbance is not None and not callable(disturbance):
+        raise InputError(f"disturbance = {describe(disturbance)}: expected a callable w(t, speed)")
+    if limits is not None and not isinstance(limits, Limits):
+        raise InputError(f"limits = {describe(limits)}: expected an aeroservo.design.Limits")
     limits = limits or Limits()
-    controls = list(controller.controls)
+    controls = check_names("controller.controls", controller.controls)
     dist = ["gust"] if disturbance is not None else []
-    rec = list(plant.output_labels) if outputs is None else list(outputs)
+    rec = list(plant.output_labels) if outputs is None else check_names("outputs", outputs)
     sensors = list(getattr(controller, "sensors", ()))
     out_names = list(dict.fromkeys(rec + sensors))
+    n_steps = _samples(
+        duration, dt, plant.nstates, len(rec), len(controls), len(dist), len(sensors), record_states
+    )
+    _check_noise(sensor_noise, plant.output_labels)
     sp = SampledPlant.from_statespace(plant, dt, controls, dist, out_names)
-    n_steps = int(round(duration / dt))
     t = np.arange(n_steps + 1) * dt
     speed = float(getattr(plant, "speed", np.nan))
     d = np.zeros((n_steps + 1, len(dist)))
     if disturbance is not None:
         if not np.isfinite(speed):
             raise InputError("simulate: the plant has no 'speed' attribute (needed by gusts)")
-        d[:, 0] = disturbance(t, speed)
-    x = np.zeros(sp.n_states) if x0 is None else np.asarray(x0, dtype=float).copy()
-    if x.shape != (sp.n_states,):
-        raise InputError(f"x0: expected {sp.n_states} states, got shape {x.shape}")
+        w = np.asarray(disturbance(t, speed))
+        if w.dtype.kind not in "iuf" or w.shape not in ((), t.shape) or not np.all(np.isfinite(w)):
+            raise InputError(
+                f"disturbance: returned {w.dtype} values of shape {w.shape}; expected finite "
+                f"gust velocities [m/s] of shape {t.shape}"
+            )
+        d[:, 0] = w
+    x = np.zeros(sp.n_states) if x0 is None else _initial_state(x0, sp.n_states)
     mag, rate = limits.arrays(controls)
     s_idx = [out_names.index(s) for s in sensors]
     rec_idx = [i for i, n in enumerate(out_names) if n in rec]
@@ -139,6 +170,57 @@ def simulate(
         states=X,
         wall_time=wall,
     )
+
+
+def _samples(duration, dt, n, n_rec, m, nd, n_sens, record_states) -> int:
+    """Number of steps of a run, refused above :data:`MAX_SAMPLES` or :data:`MAX_BYTES`."""
+    n_steps = int(round(duration / dt))
+    if n_steps < 1:
+        raise InputError(f"duration = {duration:g}: shorter than one sample period ({dt:g} s)")
+    if n_steps + 1 > MAX_SAMPLES:
+        raise InputError(
+            f"duration = {duration:g}: {n_steps + 1} samples at {1 / dt:g} Hz, above the limit "
+            f"of {MAX_SAMPLES} samples"
+        )
+    per_sample = 1 + n_rec + (n if record_states else 0) + 2 * m + nd + 2 * n_sens
+    need = 8 * (n_steps + 1) * per_sample
+    if need > MAX_BYTES:
+        raise InputError(
+            f"duration = {duration:g}: {n_steps + 1} samples x {per_sample} recorded values "
+            f"need {need / 2**30:.3g} GiB, above the limit of {MAX_BYTES / 2**30:g} GiB; "
+            "shorten the run or record fewer signals"
+        )
+    return n_steps
+
+
+def _check_noise(noise, outputs) -> None:
+    if noise is None:
+        return
+    if not isinstance(noise, Mapping):
+        raise InputError(
+            f"sensor_noise = {describe(noise)}: expected a mapping of sensor name -> standard "
+            "deviation"
+        )
+    for name, sd in noise.items():
+        if name not in outputs:
+            raise InputError(
+                f"sensor_noise: {describe(name)} is not an output of the plant {list(outputs)}"
+            )
+        check_number(f"sensor_noise[{name!r}]", sd, lo=0.0)
+
+
+def _initial_state(x0, n: int) -> np.ndarray:
+    try:
+        x = np.array(x0)
+    except ValueError:  # ragged nesting
+        x = np.array(None)
+    if x.dtype.kind not in "iuf":
+        raise InputError(f"x0 = {describe(x0)}: expected a real array of {n} states")
+    if x.shape != (n,):
+        raise InputError(f"x0: expected {n} states, got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise InputError("x0: has NaN or infinite entries")
+    return x.astype(float)
 
 
 _BLOCK = 1024

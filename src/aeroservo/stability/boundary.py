@@ -131,6 +131,10 @@ def flutter_boundary(
     -------
     FlutterResult
     """
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress = {progress!r}: expected a callable(speed) or None")
+    if not isinstance(exact_branches, (bool, np.bool_)):
+        raise InputError(f"exact_branches = {exact_branches!r}: expected True or False")
     system, src = _as_system(model, density, mach)
     n_min = MIN_MODES if n_modes is None else check_int("n_modes", n_modes, lo=1, hi=system.n_q)
     rtol = check_number("rtol", rtol, lo=1e-14, hi=1e-2)

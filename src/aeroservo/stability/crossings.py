@@ -162,7 +162,9 @@ def sign_changes(
     for k in range(first + 1, V.size - 1):
         for sgn in (1.0, -1.0):
             gk = sgn * g
-            if not (gk[k] >= gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
+            # strictly above the left neighbour: a flat top of two equal grid values (a hump
+            # symmetric about their midpoint) is searched once, not twice
+            if not (gk[k] > gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
                 continue
             if abs(zeta[k]) >= HUMP_ZETA:
                 continue

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from ..errors import InputError, check_number
 from ..system.first_order import FirstOrderSystem
 
 __all__ = ["divergence_speed", "divergence_speeds", "static_speeds"]
@@ -35,8 +36,10 @@ def static_speeds(Ks: np.ndarray, K_static: np.ndarray, density: float) -> np.nd
     density : float
         Air density [kg/m^3].
     """
-    Ks = np.asarray(Ks, dtype=float)
-    K_static = np.asarray(K_static, dtype=float)
+    Ks, K_static = _square("Ks", Ks), _square("K_static", K_static)
+    if K_static.shape != Ks.shape:
+        raise InputError(f"K_static: shape {K_static.shape}, expected {Ks.shape} like Ks")
+    density = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
     w2, phi = sla.eigh(Ks)  # Ks = phi diag(w2) phi^T, w2 > 0
     scale = phi / np.sqrt(np.clip(w2, np.finfo(float).tiny, None))
     S = -(scale.T @ K_static @ scale)
@@ -51,6 +54,7 @@ def static_speeds(Ks: np.ndarray, K_static: np.ndarray, density: float) -> np.nd
 
 def divergence_speeds(system: FirstOrderSystem) -> np.ndarray:
     """Every static divergence speed [m/s] of a first-order system, increasing."""
+    _check_system(system)
     return static_speeds(system.Ks.toarray(), system.K_static, system.density)
 
 
@@ -60,5 +64,28 @@ def divergence_speed(system: FirstOrderSystem) -> float | None:
     Solves ``Ks q = -rho V^2 K_static q`` for the smallest positive ``V^2``
     (:func:`static_speeds`).
     """
+    _check_system(system)
     v = divergence_speeds(system)
     return float(v[0]) if v.size else None
+
+
+def _check_system(system: object) -> None:
+    if not isinstance(system, FirstOrderSystem):
+        what = type(system).__name__ if system is not None else "None"
+        raise InputError(
+            f"system = <{what}>: expected a FirstOrderSystem (pass model.system(density) for "
+            "an AeroelasticModel or a TypicalSection)"
+        )
+
+
+def _square(field: str, value: object) -> np.ndarray:
+    """A finite real square matrix as a float array, or InputError."""
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged nesting
+        a = np.asarray(None)
+    if a.dtype.kind not in "iuf" or a.ndim != 2 or a.shape[0] != a.shape[1] or a.size == 0:
+        raise InputError(f"{field}: expected a real square matrix, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{field}: has NaN or infinite entries")
+    return a.astype(float)

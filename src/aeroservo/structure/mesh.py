@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_int
+from ..errors import MAX_ELEMENTS, InputError, check_int
 from .wing import Wing
 
 __all__ = ["Mesh", "build_mesh", "LOCAL_DOFS", "EDGE_TOLERANCE"]
@@ -174,7 +174,7 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
     -------
     Mesh
     """
-    n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
+    n_elements = check_int("n_elements", n_elements, lo=1, hi=MAX_ELEMENTS)
     snap, bp, warnings = _merged_edges(wing)
     extent = np.array([[snap[cs.start], snap[cs.end]] for cs in wing.control_surfaces])
     extent = extent.reshape(len(wing.control_surfaces), 2)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, check_number
+from ..errors import RANGES, InputError, check_number, check_quantity
 
 __all__ = ["Segment", "Actuator", "ControlSurface", "Wing"]
 
@@ -58,18 +58,20 @@ class Segment:
     name: str = "segment"
 
     def __post_init__(self) -> None:
-        n = self.name
-        check_number(f"{n}.start", self.start, unit="m", lo=0.0)
-        check_number(f"{n}.end", self.end, unit="m", lo=self.start, lo_open=True)
-        check_number(f"{n}.semichord", self.semichord, unit="m", lo=0.0, lo_open=True)
+        n = _name("segment", self.name)
+        span_hi = RANGES["span"].hi
+        check_number(f"{n}.start", self.start, unit="m", lo=0.0, hi=span_hi)
+        check_number(f"{n}.end", self.end, unit="m", lo=self.start, hi=span_hi, lo_open=True)
+        check_quantity(f"{n}.semichord", self.semichord, "semichord")
         check_number(f"{n}.a", self.a, lo=-1.0, hi=1.0)
-        check_number(f"{n}.mass", self.mass, unit="kg/m", lo=0.0, lo_open=True)
+        check_quantity(f"{n}.mass", self.mass, "mass_per_length")
         check_number(f"{n}.x_alpha", self.x_alpha, lo=-1.0 - self.a, hi=1.0 - self.a)
+        check_quantity(f"{n}.inertia", self.inertia, "inertia_per_length")
         s_alpha = self.mass * self.x_alpha * self.semichord
         i_min = s_alpha**2 / self.mass
         check_number(f"{n}.inertia", self.inertia, unit="kg m", lo=i_min, lo_open=True)
-        check_number(f"{n}.EI", self.EI, unit="N m^2", lo=0.0, lo_open=True)
-        check_number(f"{n}.GJ", self.GJ, unit="N m^2", lo=0.0, lo_open=True)
+        check_quantity(f"{n}.EI", self.EI, "stiffness")
+        check_quantity(f"{n}.GJ", self.GJ, "stiffness")
 
     @property
     def static_moment(self) -> float:
@@ -94,8 +96,9 @@ class Actuator:
     name: str = "actuator"
 
     def __post_init__(self) -> None:
-        check_number(f"{self.name}.station", self.station, unit="m", lo=0.0)
-        check_number(f"{self.name}.stiffness", self.stiffness, unit="N m/rad", lo=0.0, lo_open=True)
+        n = _name("actuator", self.name)
+        check_number(f"{n}.station", self.station, unit="m", lo=0.0, hi=RANGES["span"].hi)
+        check_quantity(f"{n}.stiffness", self.stiffness, "actuator_stiffness")
 
 
 @dataclass(frozen=True)
@@ -142,14 +145,15 @@ class ControlSurface:
                 "(letters, digits, underscore; used in signal names)"
             )
         n = f"control_surface '{self.name}'"
-        object.__setattr__(self, "actuators", tuple(self.actuators))
-        check_number(f"{n}.start", self.start, unit="m", lo=0.0)
-        check_number(f"{n}.end", self.end, unit="m", lo=self.start, lo_open=True)
+        object.__setattr__(self, "actuators", _sequence(f"{n}.actuators", self.actuators))
+        span_hi = RANGES["span"].hi
+        check_number(f"{n}.start", self.start, unit="m", lo=0.0, hi=span_hi)
+        check_number(f"{n}.end", self.end, unit="m", lo=self.start, hi=span_hi, lo_open=True)
         check_number(f"{n}.hinge", self.hinge, lo=-1.0, hi=1.0, hi_open=True)
-        check_number(f"{n}.static_moment", self.static_moment, unit="kg m/m")
-        check_number(f"{n}.inertia", self.inertia, unit="kg m", lo=0.0, lo_open=True)
-        check_number(f"{n}.GJ", self.GJ, unit="N m^2", lo=0.0)
-        check_number(f"{n}.hinge_stiffness", self.hinge_stiffness, unit="N m/rad/m", lo=0.0)
+        check_quantity(f"{n}.static_moment", self.static_moment, "static_moment")
+        check_quantity(f"{n}.inertia", self.inertia, "inertia_per_length")
+        check_quantity(f"{n}.GJ", self.GJ, "flap_stiffness")
+        check_quantity(f"{n}.hinge_stiffness", self.hinge_stiffness, "hinge_stiffness")
         for i, act in enumerate(self.actuators):
             if not isinstance(act, Actuator):
                 raise InputError(f"{n}.actuators[{i}] = {act!r}: expected an Actuator")
@@ -186,9 +190,12 @@ class Wing:
     name: str = "wing"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "segments", tuple(self.segments))
-        object.__setattr__(self, "control_surfaces", tuple(self.control_surfaces))
-        span = check_number("wing.span", self.span, unit="m", lo=0.0, lo_open=True)
+        if not isinstance(self.name, str):
+            raise InputError(f"wing.name = {self.name!r}: expected a string")
+        object.__setattr__(self, "segments", _sequence("wing.segments", self.segments))
+        surfaces = _sequence("wing.control_surfaces", self.control_surfaces)
+        object.__setattr__(self, "control_surfaces", surfaces)
+        span = check_quantity("wing.span", self.span, "span")
         tol = 1e-9 * span
         if not self.segments:
             raise InputError("wing.segments = []: at least one segment is required")
@@ -225,6 +232,8 @@ class Wing:
             for seg in self.segments:
                 if seg.end > cs.start + tol and seg.start < cs.end - tol:
                     _check_flap_section(seg, cs)
+        for seg in self.segments:
+            _check_frequencies(seg, span)
 
     def segment_at(self, x: float) -> Segment:
         """Segment containing station ``x`` [m] (the inboard one at a boundary)."""
@@ -245,6 +254,43 @@ class Wing:
     def mass(self) -> float:
         """Total wing mass [kg]."""
         return float(sum(s.mass * (s.end - s.start) for s in self.segments))
+
+
+def _name(kind: str, name: object) -> str:
+    if not isinstance(name, str):
+        raise InputError(f"{kind}.name = {name!r}: expected a string")
+    return name
+
+
+def _sequence(field: str, value: object) -> tuple:
+    """A tuple of the items of a list or tuple (a single item or a string is refused)."""
+    if not isinstance(value, (list, tuple)):
+        raise InputError(
+            f"{field} = {value!r}: expected a list or tuple (put a single item in a list)"
+        )
+    return tuple(value)
+
+
+FREQUENCY_RANGE = (1e-3, 1e5)
+"""Allowed first bending and torsion frequencies of a cantilever with a segment's properties
+over the whole span [Hz]: a value outside it is a unit error, and beyond it the eigenvalue
+problems lose their accuracy."""
+
+
+def _check_frequencies(seg: Segment, span: float) -> None:
+    """The segment's properties, as a uniform cantilever of the wing's span, must give first
+    bending and torsion frequencies within :data:`FREQUENCY_RANGE` (a unit check)."""
+    two_pi = 2.0 * np.pi
+    f_bending = 1.875**2 / two_pi * np.sqrt(seg.EI / (seg.mass * span**4))
+    f_torsion = 0.25 / span * np.sqrt(seg.GJ / seg.inertia)
+    lo, hi = FREQUENCY_RANGE
+    checks = (("bending", f_bending, "EI, mass"), ("torsion", f_torsion, "GJ, inertia"))
+    for what, f, keys in checks:
+        if not lo <= f <= hi:
+            raise InputError(
+                f"{seg.name}: its {keys} and the span give a first {what} frequency of "
+                f"{f:.3g} Hz, outside [{lo:g}, {hi:g}] Hz: check the units [SI]"
+            )
 
 
 def _check_flap_section(seg: Segment, cs: ControlSurface) -> None:

@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..aero.atmosphere import KNOT, RHO0, isa
-from ..errors import InputError, check_number
+from ..errors import InputError, check_number, check_quantity
 from ..stability.matched import flutter_at
 
 __all__ = ["EnvelopePoint", "Envelope", "flutter_envelope", "MARGIN"]
@@ -59,6 +59,27 @@ class EnvelopePoint:
             for k in ("envelope_eas", "required_eas", "margin_ok"):
                 out.pop(k)
         return out
+
+
+def _optional_number(key: str, value: object) -> float | None:
+    return None if value is None else check_number(key, value)
+
+
+def _checked_point(i: int, p: object, names: set) -> dict:
+    """The fields of a saved envelope point, with their types checked."""
+    if not isinstance(p, dict):
+        raise InputError(f"points[{i}] = {p!r}: expected an object")
+    out = {k: v for k, v in p.items() if k in names}
+    for k, v in out.items():
+        if k == "warnings":
+            if not isinstance(v, list) or not all(isinstance(w, str) for w in v):
+                raise InputError(f"points[{i}].warnings = {v!r}: expected a list of strings")
+        elif k == "margin_ok":
+            if v is not None and not isinstance(v, bool):
+                raise InputError(f"points[{i}].margin_ok = {v!r}: expected true, false or null")
+        else:
+            out[k] = _optional_number(f"points[{i}].{k}", v)
+    return out
 
 
 @dataclass
@@ -112,15 +133,17 @@ class Envelope:
     def from_dict(cls, data: dict) -> Envelope:
         """The envelope of :meth:`to_dict` (e.g. read back from ``envelope --save``)."""
         names = set(EnvelopePoint.__dataclass_fields__)
+        if not isinstance(data, dict) or not isinstance(data.get("points"), list):
+            raise InputError("not a valid flutter envelope (no list 'points')")
         try:
             points = [
-                EnvelopePoint(**{k: v for k, v in p.items() if k in names}) for p in data["points"]
+                EnvelopePoint(**_checked_point(i, p, names)) for i, p in enumerate(data["points"])
             ]
             return cls(
                 points=points,
-                vd=data.get("vd_eas"),
-                md=data.get("md"),
-                margin=data.get("margin") or MARGIN,
+                vd=_optional_number("vd_eas", data.get("vd_eas")),
+                md=_optional_number("md", data.get("md")),
+                margin=_optional_number("margin", data.get("margin")) or MARGIN,
                 compressibility=data.get("compressibility"),
                 damping=str(data.get("damping", "none")),
                 wing=str(data.get("wing", "")),
@@ -260,7 +283,7 @@ def flutter_envelope(
     if not alts:
         raise InputError("altitudes = []: give at least one altitude")
     if vd is not None:
-        vd = check_number("vd", vd, unit="m/s EAS", lo=0.0, lo_open=True)
+        vd = check_quantity("vd", vd, "flight_speed")
     if md is not None:
         md = check_number("md", md, lo=0.0, hi=5.0, lo_open=True)
     margin = check_number("margin", margin, lo=1.0, hi=3.0)

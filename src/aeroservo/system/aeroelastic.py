@@ -8,7 +8,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..aero.indicial import IndicialSet, wagner_set
-from ..errors import InputError, check_int, check_number
+from ..errors import MAX_ELEMENTS, InputError, check_int, check_number
 from ..structure.mesh import Mesh, build_mesh
 from ..structure.wing import Wing
 from .assembly import assemble, element_properties
@@ -70,7 +70,7 @@ class AeroelasticModel:
         if not isinstance(wing, Wing):
             raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
         self.wing = wing
-        self.n_elements = check_int("n_elements", n_elements, lo=1, hi=100_000)
+        self.n_elements = check_int("n_elements", n_elements, lo=1, hi=MAX_ELEMENTS)
         self.wagner: IndicialSet = wagner_set(wagner)
         self.damping = NO_DAMPING if damping is None else damping
         self.mesh: Mesh = build_mesh(wing, self.n_elements)

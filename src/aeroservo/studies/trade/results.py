@@ -162,18 +162,34 @@ def load_trade(out_dir: str | Path) -> TradeResult:
     TradeResult
         Table from the CSV, dataset from the NetCDF file (``n_skipped`` = number of cases).
     """
-    import pandas as pd
-    import xarray as xr
 
     out = Path(out_dir)
     try:
         manifest = json.loads((out / "study.json").read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         raise InputError(f"out_dir = {str(out)!r}: no readable study.json ({exc})") from None
+    if not isinstance(manifest, dict):
+        raise InputError(f"{out / 'study.json'}: not a trade-study manifest (a JSON object)")
     if manifest.get("format") != FORMAT:
         raise InputError(
             f"{out / 'study.json'}: format = {manifest.get('format')!r}; expected {FORMAT!r}"
         )
+    try:
+        return _read_study(out, manifest)
+    except InputError:
+        raise
+    except (KeyError, TypeError, ValueError, OSError, AttributeError) as exc:
+        why = " ".join(str(exc).split())[:120]
+        raise InputError(
+            f"{out}: not a readable trade study ({type(exc).__name__}: {why})"
+        ) from None
+
+
+def _read_study(out: Path, manifest: dict) -> TradeResult:
+    """The table and dataset a study's manifest names (any damage raises)."""
+    import pandas as pd
+    import xarray as xr
+
     csv, nc = out / manifest["csv"], out / manifest["netcdf"]
     for p in (csv, nc):
         if not p.is_file():

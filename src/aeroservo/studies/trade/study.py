@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...design.spec import ControllerSpec
-from ...errors import InputError, check_int, check_number
+from ...errors import MAX_ELEMENTS, InputError, check_int, check_number
 from ...structure.wing import Wing
 from ...system.damping import NO_DAMPING, StructuralDamping
 
@@ -220,7 +220,7 @@ class TradeStudy:
             put(self, key, _names(key, getattr(self, key)))
         if not self.controls:
             raise InputError("controls = (): give at least one control input")
-        put(self, "elements", check_int("elements", self.elements, lo=1, hi=1000))
+        put(self, "elements", check_int("elements", self.elements, lo=1, hi=MAX_ELEMENTS))
         put(self, "n_grid", check_int("n_grid", self.n_grid, lo=3, hi=10_000))
         if self.design_modes is not None:
             put(self, "design_modes", check_int("design_modes", self.design_modes, lo=1))
