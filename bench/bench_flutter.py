@@ -7,6 +7,9 @@
    on a fresh model of the same wing (target: <= 20 such boundaries: the density-independent
    matrices are built once); the Prandtl-Glauert envelope (matched Mach at every altitude)
    is reported too.
+4. All analytic sensitivities of the Goland wing with aileron (12 parameters: flutter speed and
+   frequency, divergence speed) versus one flutter boundary of the same model (target, issue
+   16: <= 3 boundaries; central differences would cost 24).
 
 The whole-process start-up is in ``bench_startup.py``.
 
@@ -82,6 +85,20 @@ def envelope_cost(quick: bool) -> dict:
     }
 
 
+def sensitivity_cost(quick: bool) -> dict:
+    from aeroservo.stability.sensitivity import flutter_sensitivities
+
+    model = aes.AeroelasticModel(aes.examples.goland_aileron(), 10)
+    flutter_sensitivities(model, 1.225)  # warm-up
+    ratios = []
+    for _ in range(3 if quick else 9):
+        one = median_time(lambda: aes.flutter_boundary(model, 1.225), 1)
+        sens = median_time(lambda: flutter_sensitivities(model, 1.225), 1)
+        ratios.append(sens / one)
+    n = len(flutter_sensitivities(model, 1.225).d_flutter_speed)
+    return {"ratio": statistics.median(ratios), "n": n, "one_s": one}
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     print("aeroservo flutter benchmarks (medians; ratios to baselines of the same run)")
@@ -108,6 +125,12 @@ def main() -> None:
         f"  16-altitude envelope: {e['env_s']:.3f} s = {ratio:.1f} x one boundary "
         f"({e['one_s'] * 1e3:.1f} ms, fresh model) [target <= 20: "
         f"{'PASS' if ratio <= 20 else 'FAIL'}]{pg}"
+    )
+    s = sensitivity_cost(quick)
+    print(
+        f"  sensitivities, Goland with aileron: {s['n']} parameters for {s['ratio']:.2f} x one "
+        f"boundary ({s['one_s'] * 1e3:.1f} ms; central differences: {2 * s['n']} boundaries) "
+        f"[target <= 3: {'PASS' if s['ratio'] <= 3 else 'FAIL'}]"
     )
 
 

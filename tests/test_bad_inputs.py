@@ -389,6 +389,10 @@ PLOTS = [
     case("plot-modes-99", ["plot", "f.npz", "--modes", "99"], {"f.npz": GOOD_NPZ}, ["99"]),
     case("plot-fmax-neg", ["plot", "f.npz", "--fmax", "-1"], {"f.npz": GOOD_NPZ}, ["--fmax"]),
     case(
+        "plot-g-1e308", ["plot", "f.npz", "--g-required", "1e308"], {"f.npz": GOOD_NPZ}, ["[0, 2)"]
+    ),
+    case("flutter-g-required", ["flutter", "goland", "--g-required", "5"], {}, ["--g-required"]),
+    case(
         "envelope-json-cut",
         ["plot", "e.json"],
         {"e.json": '{"format": "aeroser'},

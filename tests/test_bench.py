@@ -17,7 +17,7 @@ BENCH = Path(__file__).resolve().parents[1] / "bench"
     "script,targets",
     [
         ("bench_startup.py", 6),
-        ("bench_flutter.py", 3),
+        ("bench_flutter.py", 4),
         ("bench_mpc_step.py", 1),
         ("bench_trade.py", 1),
     ],

@@ -132,7 +132,10 @@ FLUTTER_MODULES = {
     "aeroservo._version",
     "aeroservo.errors",
     *(f"aeroservo.aero{m}" for m in ("", ".atmosphere", ".indicial", ".theodorsen")),
-    *(f"aeroservo.cli{m}" for m in ("", ".analysis", ".options", ".results", ".scenarios")),
+    *(
+        f"aeroservo.cli{m}"
+        for m in ("", ".analysis", ".options", ".results", ".scenarios", ".sensitivity")
+    ),
     *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".user_files", ".wing_file")),
     *(
         f"aeroservo.stability{m}"

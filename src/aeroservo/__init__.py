@@ -27,6 +27,7 @@ _PUBLIC = {
     "divergence_speed": "stability.divergence",
     "eigen_sweep": "stability.sweep",
     "flutter_boundary": "stability.boundary",
+    "flutter_sensitivities": "stability.sensitivity",
     "load_result": "files.results",
     "save_result": "files.results",
     "statespace": "linear.models",

@@ -150,6 +150,7 @@ RANGES: dict[str, Range] = {
     "limit": Range(0.0, 1e12, "signal units (per s for rates)", lo_open=True),
     "variance": Range(0.0, 1e6, "signal units^2"),
     "frequency": Range(0.0, 1e5, "Hz"),
+    "structural_g": Range(0.0, 2.0, hi_open=True),
 }
 """Allowed range of every physical quantity (documented in ``docs/conventions.md``)."""
 

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from .._threads import blas_limited
 from ..errors import InputError
-from . import analysis, results, scenarios
+from . import analysis, results, scenarios, sensitivity
 
 __all__ = ["main"]
 
@@ -49,6 +49,7 @@ def _parser() -> argparse.ArgumentParser:
     analysis.add_parsers(sub)
     scenarios.add_parsers(sub)
     results.add_parsers(sub)
+    sensitivity.add_parsers(sub)
     return p
 
 
@@ -131,7 +132,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    handlers = {**analysis.HANDLERS, **scenarios.HANDLERS, **results.HANDLERS}
+    handlers = {
+        **analysis.HANDLERS,
+        **scenarios.HANDLERS,
+        **results.HANDLERS,
+        **sensitivity.HANDLERS,
+    }
     try:
         if getattr(args, "json", False):
             with _json_stdout():

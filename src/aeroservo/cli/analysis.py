@@ -61,7 +61,7 @@ def add_parsers(sub) -> None:
     )
     f.add_argument(
         "--g-required",
-        type=positive_float,
+        type=quantity("structural_g"),
         metavar="G",
         help="required damping margin drawn on the V-g plot (e.g. 0.03)",
     )

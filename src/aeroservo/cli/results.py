@@ -52,7 +52,9 @@ def add_parsers(sub) -> None:
     pl.add_argument("--modes", type=_mode_list, metavar="LIST", help="modes to draw, e.g. 1,2,4")
     pl.add_argument("--units", choices=("si", "knots"), default="si", help="speed units")
     pl.add_argument("--eas", action="store_true", help="equivalent airspeed on the speed axis")
-    pl.add_argument("--g-required", type=positive_float, metavar="G", help="required damping")
+    pl.add_argument(
+        "--g-required", type=quantity("structural_g"), metavar="G", help="required damping g"
+    )
 
     ex = sub.add_parser(
         "export",

@@ -15,6 +15,7 @@ _PUBLIC = {
     "plot_mode_shapes": "modes",
     "plot_modes": "modes",
     "plot_root_locus": "flutter",
+    "plot_sensitivities": "sensitivity",
     "plot_vg": "flutter",
 }
 
@@ -27,6 +28,7 @@ __all__ = [
     "plot_envelope",
     "plot_loop_margins",
     "plot_margin_sweep",
+    "plot_sensitivities",
 ]
 
 __getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

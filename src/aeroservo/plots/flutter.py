@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import check_quantity
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
@@ -156,6 +158,7 @@ def plot_vg(
         ax_f.plot([], [], " ", label=f"{left_out} more mode{'s' * (left_out > 1)} not drawn")
     ax_g.axhline(0.0, color="k", lw=0.8)
     if g_required is not None:
+        check_quantity("g_required", g_required, "structural_g")
         label = f"g = -{g_required:g} (required damping)"
         ax_g.axhline(-g_required, color="r", lw=0.9, ls="--", label=label)
     for c in result.crossings:

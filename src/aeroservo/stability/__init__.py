@@ -1,7 +1,8 @@
 """Stability versus airspeed: eigenpair continuation (:mod:`.tracking`), the flutter and
 divergence boundary (:mod:`.boundary`, :mod:`.divergence`), dense eigenvalue sweeps
-(:mod:`.sweep`) and the frequency-domain p-k method with exact Theodorsen aerodynamics
-(:mod:`.pk`).
+(:mod:`.sweep`), the frequency-domain p-k method with exact Theodorsen aerodynamics
+(:mod:`.pk`) and analytic sensitivities of the flutter and divergence speeds
+(:mod:`.sensitivity`).
 """
 
 from .._lazy import lazy_attributes
@@ -13,6 +14,8 @@ _PUBLIC = {
     "divergence_speed": "divergence",
     "eigen_sweep": "sweep",
     "flutter_boundary": "boundary",
+    "flutter_sensitivities": "sensitivity",
+    "FlutterSensitivities": "sensitivity",
     "pk_flutter": "pk",
 }
 
@@ -23,6 +26,8 @@ __all__ = [
     "divergence_speed",
     "eigen_sweep",
     "flutter_boundary",
+    "flutter_sensitivities",
+    "FlutterSensitivities",
     "pk_flutter",
 ]
 

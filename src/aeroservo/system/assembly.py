@@ -6,6 +6,8 @@ Everything here runs once per (wing, mesh); speeds and densities only scale the 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -15,7 +17,7 @@ from ..structure.mesh import Mesh
 from ..structure.wing import Wing
 from .matrices import AeroMatrices, StripGroup
 
-__all__ = ["assemble", "element_properties"]
+__all__ = ["assemble", "element_properties", "structural_derivative", "STRUCTURAL_PARAMETERS"]
 
 
 def element_properties(wing: Wing, mesh: Mesh) -> dict[str, np.ndarray]:
@@ -220,3 +222,83 @@ def _actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
                     cols.append(dofs[j])
                     vals.append(act.stiffness * nd[i] * nd[j])
     return sp.coo_matrix((vals, (rows, cols)), shape=(n_q, n_q)).tocsr()
+
+
+STRUCTURAL_PARAMETERS = {
+    "segment": ("mass", "x_alpha", "inertia", "EI", "GJ"),
+    "surface": ("static_moment", "inertia", "GJ", "hinge_stiffness"),
+    "actuator": ("stiffness",),
+}
+"""Parameters that enter only the structural matrices, by owner (wing-file keys)."""
+
+
+def structural_derivative(
+    wing: Wing, mesh: Mesh, owner: str, index: tuple[int, ...], key: str
+) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Derivatives ``(dMs/dp, dKs/dp)`` of the structural matrices with respect to one
+    parameter, from the element integrals of the derivative of the section matrices.
+
+    Parameters
+    ----------
+    wing : Wing
+    mesh : Mesh
+    owner : {"segment", "surface", "actuator"}
+        What the parameter belongs to (:data:`STRUCTURAL_PARAMETERS`).
+    index : tuple of int
+        ``(i,)`` for ``segments[i]`` or ``control_surfaces[i]``, ``(k, j)`` for
+        ``control_surfaces[k].actuators[j]``.
+    key : str
+        The wing-file key (e.g. ``"EI"``).
+
+    Returns
+    -------
+    (dMs, dKs) : sparse (n_q, n_q)
+        Per unit of the parameter (the matrices are linear in every one of these parameters,
+        so the derivative is exact at any value).
+    """
+    n_q = mesh.n_dofs
+    zero = sp.csr_matrix((n_q, n_q))
+    if owner == "actuator":
+        k, j = index
+        cs = wing.control_surfaces[k]
+        act = replace(cs.actuators[j], stiffness=1.0)
+        unit = replace(wing, control_surfaces=(replace(cs, actuators=(act,)),))
+        return zero, _actuator_stiffness(unit, mesh, n_q)
+    p = element_properties(wing, mesh)
+    on = (mesh.segment if owner == "segment" else mesh.surface) == index[0]
+    dm, dk, dn = (np.zeros((mesh.n_elements, 3, 3)) for _ in range(3))
+    if owner == "segment":
+        seg = wing.segments[index[0]]
+        if key == "mass":  # S_alpha = m x_alpha b moves with m
+            dm[:, 0, 0] = 1.0
+            dm[:, 0, 1] = dm[:, 1, 0] = -seg.x_alpha * seg.semichord
+        elif key == "x_alpha":
+            dm[:, 0, 1] = dm[:, 1, 0] = -seg.mass * seg.semichord
+        elif key == "inertia":
+            dm[:, 1, 1] = 1.0
+        elif key in ("EI", "GJ"):
+            dk[:, int(key == "GJ"), int(key == "GJ")] = 1.0
+    elif key == "static_moment":
+        dm[:, 0, 2] = dm[:, 2, 0] = -1.0
+        dm[:, 1, 2] = dm[:, 2, 1] = p["b"] * (p["c"] - p["a"])
+    elif key == "inertia":
+        dm[:, 1, 2] = dm[:, 2, 1] = dm[:, 2, 2] = 1.0
+    elif key == "GJ":
+        dk[:, 2, 2] = 1.0
+    elif key == "hinge_stiffness":
+        dn[:, 2, 2] = 1.0
+    if key not in STRUCTURAL_PARAMETERS[owner]:
+        raise ValueError(f"{owner} parameter {key!r}: not a structural parameter")
+    on = on.astype(float)[:, None, None]
+    L = mesh.lengths
+    xi, wts = gauss_rule()
+    N, D, _ = field_shapes(L, xi)
+    edofs = mesh.element_dofs.copy()
+    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]  # the clamped root, dropped below
+    shape = (n_q + 3, n_q + 3)
+
+    def qq(coef, left, right):
+        blocks = integrate(L, wts, left, (coef * on)[:, None], right)
+        return _scatter(blocks, edofs, edofs, shape)[:n_q, :n_q].tocsr()
+
+    return qq(dm, N, N), qq(dk, D, D) + qq(dn, N, N)

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..errors import InputError, check_number
+from ..errors import InputError, check_number, check_quantity
 
 __all__ = ["StructuralDamping", "damping_matrix", "NO_DAMPING"]
 
@@ -74,7 +74,7 @@ class StructuralDamping:
             check_number("damping.alpha", self.alpha, unit="1/s", lo=0.0)
             check_number("damping.beta", self.beta, unit="s", lo=0.0)
         if self.kind == "structural_g":
-            check_number("damping.g", self.g, lo=0.0, hi=2.0, hi_open=True)
+            check_quantity("damping.g", self.g, "structural_g")
 
     @classmethod
     def modal(cls, ratios: float | Sequence[float]) -> StructuralDamping:
