@@ -255,8 +255,8 @@ def test_cli_flutter_at_altitude(capsys):
         (["--altitude", "1000", "--density", "1.0"], "not allowed with"),
         (["--altitude", "60000"], "altitude = 60000"),
         (["--compressibility", "prandtl-glauert"], "needs the speed of sound"),
-        (["--damping-ratio", "-0.1"], "damping.ratio[0] = -0.1"),
-        (["--structural-g", "3"], "damping.g = 3"),
+        (["--damping-ratio", "-0.1"], "--damping-ratio[0] = -0.1"),
+        (["--structural-g", "3"], "--structural-g = 3"),
         (["--rayleigh", "1"], "ALPHA,BETA"),
     ],
 )

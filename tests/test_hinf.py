@@ -110,7 +110,7 @@ def test_shipped_hinf_scenario_suppresses_flutter_with_margins():
 def test_hinf_errors_name_the_file_and_key(setup, tmp_path):
     _model, vf, loop, spec = setup
     bad = dataclasses.replace(spec, hinf=HinfWeights(roll_off=600.0))
-    with pytest.raises(aes.InputError, match=r"hinf.toml: hinf: 600 Hz is above the Nyquist"):
+    with pytest.raises(aes.InputError, match=r"hinf.toml: hinf.roll_off = 600: above the Nyquist"):
         loop.design_controller(bad, 1.1 * vf, 1000.0, vf)
     missing = dataclasses.replace(spec, sensor_scales={"tip_twist": 1e-3})
     with pytest.raises(aes.InputError, match=r"weights.sensors: give a nominal magnitude"):

@@ -29,14 +29,16 @@ def blas_threads() -> int:
     """Thread count used inside aeroservo (environment ``AEROSERVO_BLAS_THREADS``, default 1)."""
     text = os.environ.get("AEROSERVO_BLAS_THREADS", "1")
     try:
-        n = int(text)
-    except ValueError:
+        n = int(text) if text.strip().isascii() and text.strip().isdigit() else 0
+    except ValueError:  # more digits than Python converts
+        n = 0
+    if not 1 <= n <= 1024:
         from .errors import InputError
 
         raise InputError(
-            f"AEROSERVO_BLAS_THREADS = {text!r}: expected a positive integer"
-        ) from None
-    return max(n, 1)
+            f"AEROSERVO_BLAS_THREADS = {text[:40]!r}: expected an integer from 1 to 1024"
+        )
+    return n
 
 
 def blas_limited(fn: F) -> F:

@@ -106,7 +106,12 @@ def atomic_write_set(items: Sequence[tuple[str | Path, Writer]]) -> list[Path]:
             path = Path(path)
             tmp = _temporary(path)
             done.append((tmp, path))
-            write(tmp)
+            try:
+                write(tmp)
+            except OSError as exc:  # e.g. a full disk: name the file being written
+                if exc.filename is not None and str(exc.filename) == str(path):
+                    raise
+                raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
         mode = 0o666 & ~_umask()
         for tmp, path in done:
             os.chmod(tmp, mode)  # mkstemp creates 0600; results follow the umask

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 
 class InputError(ValueError):
@@ -52,7 +53,12 @@ def check_number(
             raise InputError(
                 f"{field} = {show_value(value)}: expected a real number{unit_txt}"
             ) from None
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the floating-point range
+        raise InputError(
+            f"{field} = {show_value(value)}: must be a finite number{unit_txt}"
+        ) from None
     if not math.isfinite(v):
         raise InputError(f"{field} = {v!r}: must be a finite number{unit_txt}")
     lo_ok = lo is None or (v > lo if lo_open else v >= lo)
@@ -62,6 +68,18 @@ def check_number(
         right = "inf)" if hi is None else f"{hi:g}" + (")" if hi_open else "]")
         raise InputError(f"{field} = {v:g}: allowed range is {left}, {right}{unit_txt}")
     return v
+
+
+NUMBER = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?|[+-]?(inf|nan)", re.I)
+"""A decimal number as text: what Python's ``float`` reads minus its digit separators
+(``1_000``) and non-ASCII digits."""
+
+
+def parse_number(text: str) -> float:
+    """``float(text)`` for a plain decimal number only (ValueError otherwise)."""
+    if not NUMBER.fullmatch(text.strip()):
+        raise ValueError(f"not a number: {text!r}")
+    return float(text)
 
 
 def show_value(value: object) -> str:
@@ -118,8 +136,9 @@ class Range:
         return f"{left}, {right}" + (f" {self.unit}" if self.unit else "")
 
 
-MAX_ELEMENTS = 400
-"""Most beam elements of a model (files, CLI and API): a dense 3 300-state system."""
+MAX_ELEMENTS = 300
+"""Most beam elements of a model (files, CLI and API), a 2 400-state system (at 400 elements
+the modal branches lose their match with the full model on the Goland wing)."""
 
 RANGES: dict[str, Range] = {
     # flight condition
@@ -151,6 +170,9 @@ RANGES: dict[str, Range] = {
     "variance": Range(0.0, 1e6, "signal units^2"),
     "frequency": Range(0.0, 1e5, "Hz"),
     "structural_g": Range(0.0, 2.0, hi_open=True),
+    "rayleigh_alpha": Range(0.0, 1e3, "1/s"),
+    "rayleigh_beta": Range(0.0, 1.0, "s"),
+    "estimator_variance": Range(0.0, 1e6, "signal units^2", lo_open=True),
 }
 """Allowed range of every physical quantity (documented in ``docs/conventions.md``)."""
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..errors import check_number
+from ..errors import InputError, check_number
 
 __all__ = [
     "Atmosphere",
@@ -125,6 +125,8 @@ def isa(altitude: float, *, geometric: bool = False) -> Atmosphere:
         Outside :data:`ALTITUDE_RANGE`.
     """
     h = check_number("altitude", altitude, unit="m", lo=ALTITUDE_RANGE[0], hi=ALTITUDE_RANGE[1])
+    if not isinstance(geometric, bool):
+        raise InputError(f"geometric = {geometric!r}: expected True or False")
     if geometric:
         h = R_EARTH * h / (R_EARTH + h)
     T, p = _layer_state(h)

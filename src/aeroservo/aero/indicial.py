@@ -29,6 +29,10 @@ __all__ = [
 ]
 
 
+MAX_TERMS = 12
+"""Most exponential terms of an indicial set (one lag state per term and node)."""
+
+
 def _coefficients(field: str, values: object, quantity: str) -> tuple[float, ...]:
     """A non-empty list of numbers within ``quantity``'s range (strings, booleans refused)."""
     if isinstance(values, np.ndarray):
@@ -37,6 +41,8 @@ def _coefficients(field: str, values: object, quantity: str) -> tuple[float, ...
         values = [values]
     if not isinstance(values, (list, tuple)) or not values:
         raise InputError(f"{field} = {values!r}: expected a non-empty list of numbers")
+    if len(values) > MAX_TERMS:
+        raise InputError(f"{field}: {len(values)} terms; at most {MAX_TERMS}")
     return tuple(check_quantity(f"{field}[{i}]", x, quantity) for i, x in enumerate(values))
 
 

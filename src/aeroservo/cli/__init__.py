@@ -16,7 +16,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from .._threads import blas_limited
+from .._threads import blas_limited, blas_threads
 from ..errors import InputError
 from . import analysis, results, scenarios, sensitivity
 
@@ -108,18 +108,25 @@ def _warnings_in_one_line():
                 print(f"aeroservo: warning: {category}: {text}{times}{hint}", file=sys.stderr)
 
 
-@blas_limited
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = _parser()
     try:
         args = parser.parse_args(argv)
+        blas_threads()  # the environment, checked where its error is one line
     except _UsageError as exc:
+        print(f"aeroservo: error: {exc}", file=sys.stderr)
+        return 2
+    except InputError as exc:
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2
     try:
         with _warnings_in_one_line():
-            return _run(args)
+            return blas_limited(_run)(args)
+    except BrokenPipeError:  # e.g. 'aeroservo modes goland | head -1': not an error
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
         if args.debug:
             raise
@@ -147,6 +154,8 @@ def _run(args: argparse.Namespace) -> int:
     except InputError as exc:
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        raise
     except OSError as exc:  # unwritable output folder, unreadable file
         print(f"aeroservo: error: {exc}", file=sys.stderr)
         return 2

@@ -335,7 +335,7 @@ def _envelope_text(env, units: str) -> str:
 
 
 def _cmd_modes(args: argparse.Namespace) -> int:
-    from ..errors import InputError
+    from ..errors import InputError, check_int
     from ..files.wing_file import resolve_wing
     from ..system.aeroelastic import AeroelasticModel
 
@@ -344,6 +344,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     wing, opts = resolve_wing(args.wing)
     with named("n_elements", "--elements" if args.elements else None, args, "elements"):
         model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
+    check_int("-n", args.n, lo=1, hi=model.n_dofs)
     modes = model.natural_modes(min(max(args.n, args.mode or 1), model.n_dofs))
     if args.mode is not None and args.mode > modes.frequencies.size:
         raise InputError(f"--mode = {args.mode}: the model has {modes.frequencies.size} modes")

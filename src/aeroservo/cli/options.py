@@ -6,7 +6,7 @@ import argparse
 import contextlib
 from dataclasses import dataclass
 
-from ..errors import InputError
+from ..errors import InputError, parse_number
 
 __all__ = [
     "quantity",
@@ -22,7 +22,7 @@ __all__ = [
 
 def positive_float(text: str) -> float:
     try:
-        v = float(text)
+        v = parse_number(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not v > 0 or v != v or v == float("inf"):
@@ -47,7 +47,7 @@ def quantity(name: str):
 
     def parse(text: str) -> float:
         try:
-            v = float(text)
+            v = parse_number(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
         try:
@@ -71,7 +71,7 @@ def elements(text: str) -> int:
 
 def _number(text: str) -> float:
     try:
-        v = float(text)
+        v = parse_number(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if v != v or abs(v) == float("inf"):
@@ -81,7 +81,7 @@ def _number(text: str) -> float:
 
 def _numbers(text: str) -> list[float]:
     try:
-        return [float(t) for t in text.split(",") if t.strip()]
+        return [parse_number(t) for t in text.split(",")]  # a blank item is a ValueError
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"{text!r}: expected numbers separated by commas"
@@ -153,15 +153,30 @@ class Setup:
 def _damping(args, default):
     from ..system.damping import StructuralDamping
 
-    if getattr(args, "damping_ratio", None) is not None:
-        return StructuralDamping.modal(args.damping_ratio)
-    if getattr(args, "structural_g", None) is not None:
-        return StructuralDamping.structural(args.structural_g)
-    if getattr(args, "rayleigh", None) is not None:
-        if len(args.rayleigh) != 2:
-            raise InputError(f"--rayleigh = {args.rayleigh}: give ALPHA,BETA")
-        return StructuralDamping.rayleigh(*args.rayleigh)
+    try:
+        if getattr(args, "damping_ratio", None) is not None:
+            return StructuralDamping.modal(args.damping_ratio)
+        if getattr(args, "structural_g", None) is not None:
+            return StructuralDamping.structural(args.structural_g)
+        if getattr(args, "rayleigh", None) is not None:
+            if len(args.rayleigh) != 2:
+                raise InputError(f"--rayleigh = {args.rayleigh}: give ALPHA,BETA")
+            return StructuralDamping.rayleigh(*args.rayleigh)
+    except InputError as exc:  # named by the option the user typed
+        msg = str(exc)
+        for key, option in DAMPING_OPTIONS.items():
+            if msg.startswith(key):
+                raise InputError(option + msg[len(key) :]) from None
+        raise
     return default
+
+
+DAMPING_OPTIONS = {
+    "damping.ratio": "--damping-ratio",
+    "damping.g": "--structural-g",
+    "damping.alpha": "--rayleigh ALPHA",
+    "damping.beta": "--rayleigh BETA",
+}
 
 
 @contextlib.contextmanager

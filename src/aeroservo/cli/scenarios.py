@@ -78,7 +78,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
         )
     if args.quick:
         scenario = quick(scenario)
+    if not args.out.strip():
+        raise InputError("--out = '': give an output folder")
+    if getattr(args, "scheduler", None) and scenario.kind != "trade":
+        raise InputError(
+            f"--scheduler = {args.scheduler!r}: only a trade study runs on a Dask cluster; "
+            f"{args.scenario} is a {scenario.kind} scenario"
+        )
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out = {args.out!r}: is a file, expected a folder")
     out.mkdir(parents=True, exist_ok=True)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
     run = run_scenario(

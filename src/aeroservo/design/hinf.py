@@ -79,6 +79,11 @@ class HinfWeights:
         check_number("hinf.bandwidth", self.bandwidth, unit="Hz", lo=0.0, lo_open=True)
         check_number("hinf.roll_off", self.roll_off, unit="Hz", lo=0.0, lo_open=True)
         check_number("hinf.gamma_factor", self.gamma_factor, lo=1.0, lo_open=True, hi=100.0)
+        if self.sensitivity_floor >= self.sensitivity_peak:
+            raise InputError(
+                f"hinf.sensitivity_floor = {self.sensitivity_floor:g}: must be below "
+                f"hinf.sensitivity_peak = {self.sensitivity_peak:g}"
+            )
 
 
 @dataclass
@@ -154,12 +159,15 @@ def _to_w_plane(A, B, C, D, dt: float):
 def _weights(w: HinfWeights, dt: float, n_controls: int, n_sensors: int):
     import control
 
-    def warp(f: float) -> float:
+    def warp(f: float, key: str) -> float:
         if f >= 0.5 / dt:
-            raise InputError(f"hinf: {f:g} Hz is above the Nyquist frequency {0.5 / dt:g} Hz")
+            raise InputError(
+                f"hinf.{key} = {f:g}: above the Nyquist frequency {0.5 / dt:g} Hz of the sample "
+                "rate"
+            )
         return (2 / dt) * np.tan(np.pi * f * dt)
 
-    wb, wr = warp(w.bandwidth), warp(w.roll_off)
+    wb, wr = warp(w.bandwidth, "bandwidth"), warp(w.roll_off, "roll_off")
     w1 = control.tf([1 / w.sensitivity_peak, wb], [1, wb * w.sensitivity_floor])
     w2 = w.control_weight * control.tf([1 / wr, 1], [1 / (20 * wr), 1])
     w3 = control.tf([1 / wr, 1 / w.complementary_peak], [1 / (20 * wr), 1])

@@ -37,6 +37,10 @@ TOP_KEYS = (
 HINF_KEYS = tuple(HinfWeights.__dataclass_fields__)
 
 
+MAX_SCHEDULE = 50
+"""Most design speeds of a gain schedule (each is an LQR/LQG design)."""
+
+
 def controller_from_dict(data: object, file: str = "<dict>") -> ControllerSpec:
     """Build a :class:`ControllerSpec` from a parsed controller file."""
     with one_line_errors():
@@ -128,8 +132,8 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     est = top.table("estimator").check_keys(
         ("process_noise", "sensor_noise") if top.has("estimator") else ()
     )
-    kw["process_noise"] = est.number_map("process_noise", quantity="variance")
-    kw["sensor_noise"] = est.number_map("sensor_noise", quantity="variance")
+    kw["process_noise"] = est.number_map("process_noise", quantity="estimator_variance")
+    kw["sensor_noise"] = est.number_map("sensor_noise", quantity="estimator_variance")
     for k in ("process_noise", "sensor_noise"):
         if top.has("estimator") and not kw[k]:
             est.fail(k, est.data[k], "give at least one variance")
@@ -143,6 +147,8 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     if top.has("schedule"):
         s = top.table("schedule").check_keys(("speed_factors",))
         kw["schedule"] = tuple(s.numbers("speed_factors", quantity="speed_factor", increasing=True))
+        if len(kw["schedule"]) > MAX_SCHEDULE:
+            s.fail("speed_factors", f"<{len(kw['schedule'])} speeds>", f"at most {MAX_SCHEDULE}")
         if len(kw["schedule"]) < 2:
             s.fail("speed_factors", s.data["speed_factors"], "give at least two speeds")
     return ControllerSpec(**kw)

@@ -194,6 +194,8 @@ def _need(data: dict, key: str, path: Path, kind: str, ndim: int, shape=None) ->
 
 def _sweep_from(data: dict, meta: dict, prefix: str, path: Path) -> FlutterResult:
     V = _need(data, f"{prefix}speeds", path, "f", 1)
+    if V.size < 2 or not np.all(np.isfinite(V)) or np.any(np.diff(V) <= 0) or V[0] < 0:
+        raise InputError(f"{path}: {prefix}speeds are not finite increasing speeds >= 0")
     lam = _need(data, f"{prefix}eigenvalues", path, "c", 2)
     if lam.shape[0] != V.size:
         raise InputError(f"{path}: {prefix}eigenvalues has {lam.shape[0]} rows for {V.size} speeds")

@@ -96,6 +96,9 @@ def _wing(tbl: Table, base: Path):
         raise InputError(f"{tbl.file}: {msg}") from None
 
 
+MIN_FILTER = 0.01
+"""Lowest sensor-filter cut-off [Hz] (a slower filter is a constant: give 0 for none)."""
+
 MAX_RESULT_NAME = 200
 """Longest result stem [bytes]: its longest file, ``<result>_margin_sweep.png``, and the
 temporary name it is written under stay within the usual 255-byte file-name limit."""
@@ -186,6 +189,8 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["sensors"] = tuple(sg.strings("sensors", ["tip_le_accel", "tip_te_accel", "tip_twist"]))
     kw["outputs"] = tuple(sg.strings("outputs", ["tip_disp"], nonempty=False))
     cutoff = sg.number("sensor_filter", 30.0, quantity="frequency")
+    if 0 < cutoff < MIN_FILTER:
+        sg.fail("sensor_filter", cutoff, f"0 (no filter) or at least {MIN_FILTER:g} Hz")
     kw["sensor_filter"] = None if cutoff == 0 else cutoff
     kw["filter_order"] = sg.integer("filter_order", 2, lo=1, hi=4)
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..aero.atmosphere import ALTITUDE_RANGE, FT, isa
 from ..design.spec import ControllerSpec
-from ..errors import InputError
+from ..errors import NUMBER, InputError
 from ..studies.scenario import GUST_KEYS, GUST_TYPES, Disturbance
 from .controller_file import load_controller
 from .toml_tables import Table
@@ -68,8 +68,10 @@ def gust_series(tbl: Table, path: Path, cls):
             if not row or row[0].strip().startswith("#"):
                 continue
             try:
+                if len(row) != 2 or not all(NUMBER.fullmatch(c.strip()) for c in row):
+                    raise ValueError
                 rows.append((float(row[0]), float(row[1])))
-            except (ValueError, IndexError):
+            except ValueError:
                 if i == 0:
                     continue  # header
                 tbl.fail("file", tbl.data["file"], f"line {i + 1}: expected time, velocity")

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._threads import blas_limited
 from ..design.plant import Limits, SampledPlant
-from ..errors import InputError, check_int, check_number
+from ..errors import RANGES, InputError, check_int, check_number
 from ..linear.models import SAMPLE_RATES, check_continuous
 from ..linear.signals import check_names, describe
 from .result import SimulationResult
@@ -117,11 +117,22 @@ def simulate(
     if disturbance is not None:
         if not np.isfinite(speed):
             raise InputError("simulate: the plant has no 'speed' attribute (needed by gusts)")
-        w = np.asarray(disturbance(t, speed))
-        if w.dtype.kind not in "iuf" or w.shape not in ((), t.shape) or not np.all(np.isfinite(w)):
+        try:
+            w = np.asarray(disturbance(t, speed))
+        except TypeError as exc:
+            raise InputError(
+                f"disturbance = {describe(disturbance)}: calling it as w(t, speed) failed ({exc})"
+            ) from None
+        lo, hi = RANGES["gust_velocity"].lo, RANGES["gust_velocity"].hi
+        if (
+            w.dtype.kind not in "iuf"
+            or w.shape not in ((), t.shape)
+            or not np.all(np.isfinite(w))
+            or not np.all((w >= lo) & (w <= hi))
+        ):
             raise InputError(
                 f"disturbance: returned {w.dtype} values of shape {w.shape}; expected finite "
-                f"gust velocities [m/s] of shape {t.shape}"
+                f"gust velocities in [{lo:g}, {hi:g}] m/s of shape {t.shape}"
             )
         d[:, 0] = w
     x = np.zeros(sp.n_states) if x0 is None else _initial_state(x0, sp.n_states)
@@ -206,7 +217,8 @@ def _check_noise(noise, outputs) -> None:
             raise InputError(
                 f"sensor_noise: {describe(name)} is not an output of the plant {list(outputs)}"
             )
-        check_number(f"sensor_noise[{name!r}]", sd, lo=0.0)
+        # a standard deviation: the square root of the variance range
+        check_number(f"sensor_noise[{name!r}]", sd, lo=0.0, hi=RANGES["variance"].hi ** 0.5)
 
 
 def _initial_state(x0, n: int) -> np.ndarray:

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .._threads import blas_limited
-from ..errors import InputError, check_int, check_number
+from ..errors import RANGES, InputError, check_int, check_number
 from ..system.first_order import FirstOrderSystem
 from .branches import Branches, is_complex, sweep_branches
 from .certificate import DENSE_LIMIT, Certificate, certify, truncated_modes
@@ -148,7 +148,7 @@ def flutter_boundary(
     omega_2 = float(np.abs(lam_full0[min(1, lam_full0.size - 1)]))
     if v_max is None:
         v_max = default_v_max(system.semichord, omega_2, v_div)
-    v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
+    v_max = check_number("v_max", v_max, unit="m/s", lo=RANGES["flight_speed"].lo)
     tracker = EigenTracker(system)
     basis = _checked_basis(src, n_min, rho, v_max, mach) if src is not None else None
     crossings: list[Crossing] | None = None

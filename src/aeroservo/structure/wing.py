@@ -212,6 +212,9 @@ class Wing:
         if abs(x - span) > tol:
             raise InputError(f"wing.segments[-1].end = {x:g}: must equal wing.span = {span:g} [m]")
         names = set()
+        for i, cs in enumerate(self.control_surfaces):
+            if not isinstance(cs, ControlSurface):
+                raise InputError(f"wing.control_surfaces[{i}] = {cs!r}: expected a ControlSurface")
         surfaces = sorted(self.control_surfaces, key=lambda s: s.start)
         for i, cs in enumerate(surfaces):
             if not isinstance(cs, ControlSurface):

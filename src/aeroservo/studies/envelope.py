@@ -19,8 +19,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..aero.atmosphere import KNOT, RHO0, isa
-from ..errors import InputError, check_number, check_quantity
+from ..aero.atmosphere import ALTITUDE_RANGE, KNOT, RHO0, isa
+from ..errors import InputError, check_number, check_quantity, parse_number
 from ..stability.matched import flutter_at
 
 __all__ = ["EnvelopePoint", "Envelope", "flutter_envelope", "MARGIN"]
@@ -77,8 +77,12 @@ def _checked_point(i: int, p: object, names: set) -> dict:
         elif k == "margin_ok":
             if v is not None and not isinstance(v, bool):
                 raise InputError(f"points[{i}].margin_ok = {v!r}: expected true, false or null")
-        else:
+        elif k == "altitude":
+            out[k] = check_number(f"points[{i}].altitude", v, unit="m", lo=-1000.0, hi=47000.0)
+        else:  # densities, speeds, Mach numbers, frequencies: positive where given
             out[k] = _optional_number(f"points[{i}].{k}", v)
+            if out[k] is not None and out[k] < 0:
+                raise InputError(f"points[{i}].{k} = {out[k]:g}: must be >= 0")
     return out
 
 
@@ -223,20 +227,27 @@ def parse_altitudes(text: str, unit: str = "m") -> list[float]:
     key = "--altitudes-ft" if unit == "ft" else "--altitudes"
     try:
         if ":" in text:
-            start, stop, step = (float(t) for t in text.split(":"))
+            start, stop, step = (parse_number(t) for t in text.split(":"))
             if not step > 0 or stop < start or (stop - start) / step > 1000:
                 raise ValueError
             n = int(math.floor((stop - start) / step + 1e-9)) + 1
             vals = [start + i * step for i in range(n)]
         else:
-            vals = [float(t) for t in text.split(",") if t.strip()]
+            vals = [parse_number(t) for t in text.split(",")]  # a blank item is a ValueError
     except ValueError:
         raise InputError(
             f"{key} = {text!r}: expected start:stop:step (step > 0, at most 1000 points) or a "
             "comma-separated list"
         ) from None
-    if not vals:
-        raise InputError(f"{key} = {text!r}: no altitude")
+    if len(set(vals)) != len(vals):
+        raise InputError(f"{key} = {text!r}: altitudes must not repeat")
+    lo, hi = (a / scale for a in ALTITUDE_RANGE)
+    for v in vals:
+        if not lo <= v <= hi:  # NaN included
+            raise InputError(
+                f"{key} = {text!r}: altitude {v:g} {unit} outside the standard atmosphere "
+                f"[{lo:.6g}, {hi:.6g}] {unit}"
+            )
     return [v * scale for v in vals]
 
 

@@ -71,8 +71,8 @@ class StructuralDamping:
             )
             object.__setattr__(self, "ratios", vals)
         if self.kind == "rayleigh":
-            check_number("damping.alpha", self.alpha, unit="1/s", lo=0.0)
-            check_number("damping.beta", self.beta, unit="s", lo=0.0)
+            check_quantity("damping.alpha", self.alpha, "rayleigh_alpha")
+            check_quantity("damping.beta", self.beta, "rayleigh_beta")
         if self.kind == "structural_g":
             check_quantity("damping.g", self.g, "structural_g")
 

@@ -183,6 +183,7 @@ def run_trade(
     timeout = check_number("timeout", timeout, unit="s", lo=0.0, lo_open=True)
     out = Path(out_dir)
     cases_dir = out / "cases"
+    fresh = not cases_dir.exists()  # a new study: on a failure before any case, leave nothing
     cases_dir.mkdir(parents=True, exist_ok=True)
 
     cases = trade_cases(study)
@@ -197,11 +198,16 @@ def run_trade(
 
     pending = [c for c in cases if c["case_id"] not in records]
     if pending:
-        records.update(
-            _run_pending(
+        try:
+            done = _run_pending(
                 study, pending, cases_dir, scheduler, n_workers, progress, timeout, n_skipped
             )
-        )
+        except BaseException:
+            if fresh and not any(cases_dir.iterdir()):  # e.g. no scheduler at that address
+                (out / "study.json").unlink(missing_ok=True)
+                cases_dir.rmdir()
+            raise
+        records.update(done)
 
     rows = [records[c["case_id"]] for c in cases]
     result = _assemble(study.name, study.parameters, rows, manifest["settings"])
