@@ -276,7 +276,7 @@ class Table:
     ) -> dict:
         """An inline table ``{name = number}`` (e.g. limits or noise levels by signal), each
         value within ``[lo, inf)`` or within ``quantity``'s range."""
-        hi = hi_open = None
+        hi, hi_open = None, False
         if quantity is not None:
             unit, lo, hi, lo_open, hi_open = _bounds(quantity)
         if key not in self.data:
@@ -286,7 +286,7 @@ class Table:
             if not isinstance(name, str) or not name.isidentifier():
                 sub.fail(name, val, "not a signal name (letters, digits and underscores)")
         return {
-            name: sub.check_value(name, val, unit, lo, hi, lo_open, bool(hi_open))
+            name: sub.check_value(name, val, unit, lo, hi, lo_open, hi_open)
             for name, val in sub.data.items()
         }
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -228,7 +227,7 @@ def _eigenpair(system, speed: float, sigma: complex) -> tuple[complex, np.ndarra
             y = lu.solve(E.conj().T @ y, trans="H")
             y /= np.linalg.norm(y)
         lam = (y.conj() @ (P @ x)) / (y.conj() @ (E @ x))
-    res = np.linalg.norm(P @ x - lam * (E @ x)) / max(sla.norm(P.toarray(), 1), 1.0)
+    res = np.linalg.norm(P @ x - lam * (E @ x)) / max(spla.norm(P, 1), 1.0)
     if res > 1e-8:
         raise RuntimeError(f"flutter eigenpair not converged (residual {res:.1e})")
     return lam, x, y

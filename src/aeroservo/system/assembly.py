@@ -256,6 +256,8 @@ def structural_derivative(
         Per unit of the parameter (the matrices are linear in every one of these parameters,
         so the derivative is exact at any value).
     """
+    if key not in STRUCTURAL_PARAMETERS.get(owner, ()):
+        raise ValueError(f"{owner} parameter {key!r}: not a structural parameter")
     n_q = mesh.n_dofs
     zero = sp.csr_matrix((n_q, n_q))
     if owner == "actuator":
@@ -287,8 +289,6 @@ def structural_derivative(
         dk[:, 2, 2] = 1.0
     elif key == "hinge_stiffness":
         dn[:, 2, 2] = 1.0
-    if key not in STRUCTURAL_PARAMETERS[owner]:
-        raise ValueError(f"{owner} parameter {key!r}: not a structural parameter")
     on = on.astype(float)[:, None, None]
     L = mesh.lengths
     xi, wts = gauss_rule()
