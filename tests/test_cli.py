@@ -134,7 +134,15 @@ FLUTTER_MODULES = {
     *(f"aeroservo.aero{m}" for m in ("", ".atmosphere", ".indicial", ".theodorsen")),
     *(
         f"aeroservo.cli{m}"
-        for m in ("", ".analysis", ".options", ".results", ".scenarios", ".sensitivity")
+        for m in (
+            "",
+            ".analysis",
+            ".options",
+            ".optimize",
+            ".results",
+            ".scenarios",
+            ".sensitivity",
+        )
     ),
     *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".user_files", ".wing_file")),
     *(

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from .._threads import blas_limited, blas_threads
 from ..errors import InputError
-from . import analysis, results, scenarios, sensitivity
+from . import analysis, optimize, results, scenarios, sensitivity
 
 __all__ = ["main"]
 
@@ -50,6 +50,7 @@ def _parser() -> argparse.ArgumentParser:
     scenarios.add_parsers(sub)
     results.add_parsers(sub)
     sensitivity.add_parsers(sub)
+    optimize.add_parsers(sub)
     return p
 
 
@@ -144,6 +145,7 @@ def _run(args: argparse.Namespace) -> int:
         **scenarios.HANDLERS,
         **results.HANDLERS,
         **sensitivity.HANDLERS,
+        **optimize.HANDLERS,
     }
     try:
         if getattr(args, "json", False):

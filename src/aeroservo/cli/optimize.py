@@ -1,0 +1,63 @@
+"""Command line: ``optimize`` (aeroservo.studies.optimize on an optimization file)."""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["add_parsers", "HANDLERS"]
+
+
+def add_parsers(sub) -> None:
+    """The parser of ``optimize``."""
+    p = sub.add_parser(
+        "optimize",
+        help="tailor wing parameters by SLSQP with analytic flutter-speed gradients",
+        description="Design variables, bounds, an objective and speed constraints from an "
+        "optimization file (docs/stability.md, scenarios/optimize_*.toml); every iterate is "
+        "logged, the optimum is verified by a fresh analysis.",
+    )
+    p.add_argument("file", help="optimization .toml")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--gradients",
+        choices=("analytic", "central"),
+        default="analytic",
+        help="analytic sensitivities (default) or central differences, for comparison",
+    )
+
+
+def _cmd_optimize(args: argparse.Namespace) -> int:
+    from ..files.optimize_file import load_optimization
+
+    op = load_optimization(args.file)
+    from ..studies.optimize import optimize_wing
+
+    r = optimize_wing(
+        op.wing,
+        op.density,
+        op.variables,
+        op.objective,
+        op.constraints,
+        n_elements=op.elements,
+        v_max=op.v_max,
+        gradients=args.gradients,
+    )
+    if args.json:
+        from ..files.summaries import json_text
+
+        print(json_text({"name": op.name, "gradients": args.gradients, **r.to_dict()}))
+        return 0 if r.success else 1
+    print(
+        f"{op.name}: {r.message} ({len(r.iterations)} designs analysed, "
+        f"{r.n_boundaries} flutter boundaries, {args.gradients} gradients)"
+    )
+    for n, v in r.variables.items():
+        print(f"  {n:44s} {r.start[n]:12.6g} -> {v:12.6g}")
+    print(
+        f"  objective {r.objective:.6g}; flutter {r.flutter_speed} m/s, divergence "
+        f"{r.divergence_speed} m/s (fresh analysis); active: {', '.join(r.active) or 'none'}"
+    )
+    return 0 if r.success else 1
+
+
+HANDLERS = {"optimize": _cmd_optimize}

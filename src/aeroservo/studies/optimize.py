@@ -1,0 +1,289 @@
+"""Gradient-based aeroelastic tailoring: wing parameters chosen by SLSQP with the analytic
+flutter-speed sensitivities (:mod:`aeroservo.stability.sensitivity`).
+
+The design variables are wing parameters named as in the wing file, each within bounds; the
+objective is a weighted sum of them (e.g. stiffness times length, a material proxy) to
+minimize, or the flutter speed to maximize; the constraints are lower bounds on the flutter
+and divergence speeds. Variables are scaled by their starting values. Every iterate is logged;
+the optimum is verified by a fresh analysis of a newly built model, and the active constraints
+are reported. ``gradients="central"`` solves the same problem with central differences of
+the flutter speed (two boundaries per variable and iterate) for comparison.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..errors import InputError, check_int, check_number
+from ..stability.boundary import flutter_boundary
+from ..stability.sensitivity import flutter_sensitivities, parameter_values
+from ..system.aeroelastic import AeroelasticModel
+
+__all__ = ["Optimization", "optimize_wing", "with_parameters"]
+
+ACTIVE = 1e-4
+"""A constraint within this relative margin of its bound is reported active."""
+
+
+@dataclass
+class Optimization:
+    """Result of :func:`optimize_wing` (SI units)."""
+
+    variables: dict
+    objective: float
+    flutter_speed: float | None
+    divergence_speed: float | None
+    constraints: dict
+    active: list
+    success: bool
+    message: str
+    iterations: list = field(default_factory=list)
+    n_boundaries: int = 0
+    start: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {
+            "success": self.success,
+            "message": self.message,
+            "variables": dict(self.variables),
+            "start": dict(self.start),
+            "objective": self.objective,
+            "flutter_speed": self.flutter_speed,
+            "divergence_speed": self.divergence_speed,
+            "constraints": dict(self.constraints),
+            "active_constraints": list(self.active),
+            "n_boundaries": self.n_boundaries,
+            "iterations": list(self.iterations),
+        }
+
+
+def with_parameters(wing, values: dict):
+    """The wing with parameters (wing-file names) set to ``values``."""
+    table = parameter_values(wing)
+    segs, surfaces = list(wing.segments), list(wing.control_surfaces)
+    for name, v in values.items():
+        owner, idx, key, _ = table[name]
+        if owner == "segment":
+            segs[idx[0]] = replace(segs[idx[0]], **{key: v})
+        elif owner == "surface":
+            surfaces[idx[0]] = replace(surfaces[idx[0]], **{key: v})
+        else:
+            cs = surfaces[idx[0]]
+            acts = list(cs.actuators)
+            acts[idx[1]] = replace(acts[idx[1]], stiffness=v)
+            surfaces[idx[0]] = replace(cs, actuators=tuple(acts))
+    return replace(wing, segments=tuple(segs), control_surfaces=tuple(surfaces))
+
+
+def optimize_wing(
+    wing,
+    density: float,
+    variables: dict,
+    objective: dict | str,
+    constraints: dict,
+    *,
+    n_elements: int = 10,
+    wagner: object = "rt_jones",
+    v_max: float | None = None,
+    gradients: str = "analytic",
+    max_iterations: int = 60,
+) -> Optimization:
+    """Choose wing parameters by SLSQP.
+
+    Parameters
+    ----------
+    wing : Wing
+        The starting design.
+    density : float
+        Air density [kg/m^3].
+    variables : dict
+        Parameter name -> (lower, upper) bound, in the parameter's unit.
+    objective : dict or str
+        ``{name: weight}``: minimize ``sum weight * value``; ``"flutter_speed"``: maximize it.
+    constraints : dict
+        ``flutter_speed_min`` and/or ``divergence_speed_min`` [m/s].
+    n_elements, wagner, v_max
+        The model and the top of each speed search.
+    gradients : {"analytic", "central"}
+        Analytic sensitivities, or central differences (relative step 1e-5) for comparison.
+    max_iterations : int
+
+    Returns
+    -------
+    Optimization
+    """
+    from scipy.optimize import minimize
+
+    table = parameter_values(wing)
+    names = _variables(variables, table)
+    lo = np.array([variables[n][0] for n in names], float)
+    hi = np.array([variables[n][1] for n in names], float)
+    p0 = np.clip([table[n][3] for n in names], lo, hi)
+    scale = np.where(p0 != 0, np.abs(p0), np.maximum(np.abs(hi), 1.0))
+    weights = _objective(objective, names)
+    limits = _constraints(constraints)
+    if gradients not in ("analytic", "central"):
+        raise InputError(f"gradients = {gradients!r}: allowed values are 'analytic', 'central'")
+    check_int("max_iterations", max_iterations, lo=1, hi=1000)
+    cache: dict = {}
+    log: list = []
+    count = [0]
+
+    def analyse(x: np.ndarray):
+        key = tuple(np.round(x, 14))
+        if key not in cache:
+            p = x * scale
+            model = AeroelasticModel(
+                with_parameters(wing, dict(zip(names, p, strict=True))), n_elements, wagner
+            )
+            if gradients == "analytic":
+                count[0] += 1
+                s = flutter_sensitivities(model, density, [*names], v_max=v_max)
+                vf, vd = s.flutter_speed, s.divergence_speed
+                dvf = np.array([s.d_flutter_speed.get(n, 0.0) for n in names]) * scale
+                dvd = np.array([s.d_divergence_speed.get(n, 0.0) for n in names]) * scale
+            else:
+                vf, vd, dvf, dvd = _central(
+                    wing, names, p, scale, density, n_elements, wagner, v_max, count
+                )
+            top = v_max if v_max is not None else np.inf
+            cache[key] = (vf if vf is not None else top, vd if vd is not None else top, dvf, dvd)
+            log.append(
+                {
+                    "variables": dict(zip(names, map(float, p), strict=True)),
+                    "flutter_speed": vf,
+                    "divergence_speed": vd,
+                }
+            )
+        return cache[key]
+
+    def f(x):
+        if weights is None:
+            return -analyse(x)[0] / analyse(np.ones_like(x))[0]
+        return float(weights @ (x * scale)) / float(weights @ p0)
+
+    def df(x):
+        if weights is None:
+            return -analyse(x)[2] / analyse(np.ones_like(x))[0]
+        return weights * scale / float(weights @ p0)
+
+    cons = []
+    for idx, bound in limits.values():
+        cons.append(
+            {
+                "type": "ineq",
+                "fun": lambda x, i=idx, b=bound: analyse(x)[i] / b - 1.0,
+                "jac": lambda x, i=idx, b=bound: analyse(x)[i + 2] / b,
+            }
+        )
+    sol = minimize(
+        f,
+        p0 / scale,
+        jac=df,
+        bounds=list(zip(lo / scale, hi / scale, strict=True)),
+        constraints=cons,
+        method="SLSQP",
+        options={"maxiter": max_iterations, "ftol": 1e-9},
+    )
+    best = dict(zip(names, map(float, sol.x * scale), strict=True))
+    check = flutter_boundary(
+        AeroelasticModel(with_parameters(wing, best), n_elements, wagner), density, v_max=v_max
+    )  # a fresh model and analysis
+    values = {"flutter_speed": check.flutter_speed, "divergence_speed": check.divergence_speed}
+    active, margins = [], {}
+    for k, (_idx, bound) in limits.items():
+        v = values[k.replace("_min", "")]
+        margins[k] = {"bound": bound, "value": v}
+        if v is not None and abs(v / bound - 1.0) < ACTIVE:
+            active.append(k)
+    for i, n in enumerate(names):
+        if np.isclose(sol.x[i] * scale[i], lo[i], rtol=ACTIVE) or np.isclose(
+            sol.x[i] * scale[i], hi[i], rtol=ACTIVE
+        ):
+            active.append(f"bound {n}")
+    feasible = all(
+        m["value"] is None or m["value"] >= m["bound"] * (1 - ACTIVE) for m in margins.values()
+    )
+    objective_value = (
+        check.flutter_speed if weights is None else float(weights @ np.array(list(best.values())))
+    )
+    return Optimization(
+        variables=best,
+        objective=objective_value,
+        flutter_speed=check.flutter_speed,
+        divergence_speed=check.divergence_speed,
+        constraints=margins,
+        active=active,
+        success=bool(sol.success) and feasible,
+        message=str(sol.message) + ("" if feasible else "; constraints violated on re-analysis"),
+        iterations=log,
+        n_boundaries=count[0] + 1,
+        start=dict(zip(names, map(float, p0), strict=True)),
+    )
+
+
+def _variables(variables: object, table: dict) -> list[str]:
+    if not isinstance(variables, dict) or not variables:
+        raise InputError(f"variables = {variables!r}: expected {{name: (lower, upper)}}")
+    for n, b in variables.items():
+        if n not in table:
+            raise InputError(f"variables: {n!r} is not a parameter of this wing")
+        if not isinstance(b, (list, tuple)) or len(b) != 2:
+            raise InputError(f"variables[{n!r}] = {b!r}: expected [lower, upper]")
+        a = check_number(f"variables[{n!r}][0]", b[0])
+        check_number(f"variables[{n!r}][1]", b[1], lo=a, lo_open=True)
+    return list(variables)
+
+
+def _objective(objective: object, names: list[str]) -> np.ndarray | None:
+    if objective == "flutter_speed":
+        return None
+    if not isinstance(objective, dict) or not objective:
+        raise InputError(
+            f"objective = {objective!r}: expected 'flutter_speed' or {{variable: weight}}"
+        )
+    for n, w in objective.items():
+        if n not in names:
+            raise InputError(f"objective: {n!r} is not a design variable {names}")
+        check_number(f"objective[{n!r}]", w)
+    return np.array([float(objective.get(n, 0.0)) for n in names])
+
+
+def _constraints(constraints: object) -> dict:
+    known = {"flutter_speed_min": 0, "divergence_speed_min": 1}
+    if not isinstance(constraints, dict):
+        raise InputError(f"constraints = {constraints!r}: expected a mapping")
+    out = {}
+    for k, v in constraints.items():
+        if k not in known:
+            raise InputError(f"constraints.{k}: unknown; allowed are {sorted(known)}")
+        out[k] = (known[k], check_number(f"constraints.{k}", v, unit="m/s", lo=0.1, hi=1000.0))
+    return out
+
+
+def _central(wing, names, p, scale, density, n_elements, wagner, v_max, count):
+    """Speeds and their gradients by central differences (relative step 1e-5)."""
+
+    def speeds(q):
+        count[0] += 1
+        m = AeroelasticModel(
+            with_parameters(wing, dict(zip(names, q, strict=True))), n_elements, wagner
+        )
+        r = flutter_boundary(m, density, v_max=v_max, rtol=1e-12)
+        return r.flutter_speed, r.divergence_speed
+
+    vf, vd = speeds(p)
+    dvf, dvd = np.zeros(len(p)), np.zeros(len(p))
+    for i in range(len(p)):
+        h = 1e-5 * scale[i]
+        up, dn = p.copy(), p.copy()
+        up[i] += h
+        dn[i] -= h
+        (fu, du), (fd, dd) = speeds(up), speeds(dn)
+        if fu is not None and fd is not None:
+            dvf[i] = (fu - fd) / (2 * h) * scale[i]
+        if du is not None and dd is not None:
+            dvd[i] = (du - dd) / (2 * h) * scale[i]
+    return vf, vd, dvf, dvd
