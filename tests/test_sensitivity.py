@@ -249,3 +249,28 @@ def test_cli_bad_input(argv, fragment, tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and fragment in err[0]
     assert list(tmp_path.iterdir()) == []
+
+
+# -- closed loop: central differences of a trade case (documented as such) -----------------------
+def test_closed_loop_case_sensitivities():
+    """The shipped trade study's middle case (LQR, Bryson 500 N m): derivatives of the
+    closed-loop flutter speed by central differences with two steps agree (1e-3 relative),
+    so the step is in the flat region between truncation and boundary noise."""
+    from conftest import ROOT
+
+    from aeroservo.files import load_scenario
+    from aeroservo.studies.runs import study_from_scenario
+    from aeroservo.studies.trade.sensitivity import case_sensitivities
+
+    study = study_from_scenario(load_scenario(ROOT / "scenarios" / "trade_aileron.toml"))
+    case = {"aileron_start": 0.6, "aileron_chord": 0.2, "bryson_hinge_moment": 500.0}
+    a = case_sensitivities(study, case, ["aileron_chord", "bryson_hinge_moment"], rel_step=1e-3)
+    b = case_sensitivities(study, case, ["aileron_chord", "bryson_hinge_moment"], rel_step=3e-4)
+    assert a.case["closed_loop_flutter_speed"] > a.case["open_loop_flutter_speed"]
+    da, db = a.derivatives["closed_loop_flutter_speed"], b.derivatives["closed_loop_flutter_speed"]
+    assert set(da) == {"aileron_chord", "bryson_hinge_moment"} and not a.unavailable
+    for k in da:
+        assert da[k] == pytest.approx(db[k], rel=1e-3)
+    assert "finite differences" in a.to_dict()["method"]
+    with pytest.raises(InputError, match="'hinge_stiffness' is not a parameter"):
+        case_sensitivities(study, case, ["hinge_stiffness"])
