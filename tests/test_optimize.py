@@ -118,3 +118,29 @@ def test_bad_arguments(problem):
         )
     with pytest.raises(InputError, match="not a design variable"):
         optimize_wing(problem.wing, 1.225, problem.variables, {"segments[0].EI": 1.0}, {})
+
+
+def test_codesign_shipped_case(capsys):
+    """Aileron chord and LQR Bryson weight for the highest closed-loop flutter speed under a
+    600 N m gust hinge-moment limit: a better design than the start, the limit met on a fresh
+    case, and at the interior chord the closed-loop flutter speed is stationary (central
+    differences with another step, independent of the optimizer's)."""
+    from aeroservo.files.optimize_file import load_codesign
+    from aeroservo.studies.runs import study_from_scenario
+    from aeroservo.studies.trade.sensitivity import case_sensitivities
+
+    assert main(["optimize", str(ROOT / "scenarios" / "codesign_aileron_lqr.toml"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["success"] and out["hinge_moment_peak"] <= 600.0 * (1 + 1e-3)
+    assert out["closed_loop_flutter_speed"] > 1.1 * 192.1  # the start case: 192.1 m/s
+    cd = load_codesign(ROOT / "scenarios" / "codesign_aileron_lqr.toml")
+    chord = out["variables"]["aileron_chord"]
+    assert 0.1 < chord < 0.3
+    s = case_sensitivities(
+        study_from_scenario(cd.scenario),
+        {**cd.start, **out["variables"]},
+        ["aileron_chord"],
+        rel_step=3e-3,
+    )
+    slope = s.derivatives["closed_loop_flutter_speed"]["aileron_chord"]
+    assert abs(slope * chord / out["closed_loop_flutter_speed"]) < 1e-2

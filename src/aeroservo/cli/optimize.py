@@ -16,7 +16,7 @@ def add_parsers(sub) -> None:
         "optimization file (docs/stability.md, scenarios/optimize_*.toml); every iterate is "
         "logged, the optimum is verified by a fresh analysis.",
     )
-    p.add_argument("file", help="optimization .toml")
+    p.add_argument("file", help="optimization or co-design .toml")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
         "--gradients",
@@ -28,7 +28,10 @@ def add_parsers(sub) -> None:
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
     from ..files.optimize_file import load_optimization
+    from ..files.toml_tables import read_toml
 
+    if "codesign" in read_toml(args.file):
+        return _codesign(args)
     op = load_optimization(args.file)
     from ..studies.optimize import optimize_wing
 
@@ -56,6 +59,38 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     print(
         f"  objective {r.objective:.6g}; flutter {r.flutter_speed} m/s, divergence "
         f"{r.divergence_speed} m/s (fresh analysis); active: {', '.join(r.active) or 'none'}"
+    )
+    return 0 if r.success else 1
+
+
+def _codesign(args: argparse.Namespace) -> int:
+    from ..files.optimize_file import load_codesign
+
+    cd = load_codesign(args.file)
+    from ..studies.runs import study_from_scenario
+    from ..studies.trade.codesign import codesign
+
+    r = codesign(
+        study_from_scenario(cd.scenario),
+        cd.start,
+        cd.variables,
+        hinge_moment_peak_max=cd.hinge_moment_peak_max,
+    )
+    if args.json:
+        from ..files.summaries import json_text
+
+        print(json_text({"name": cd.name, **r.to_dict()}))
+        return 0 if r.success else 1
+    c = r.case
+    print(
+        f"{cd.name}: {r.message} ({len(r.iterations)} designs, {r.n_cases} trade cases, "
+        "central-difference gradients)"
+    )
+    for n, v in r.variables.items():
+        print(f"  {n:44s} {r.start[n]:12.6g} -> {v:12.6g}")
+    print(
+        f"  closed-loop flutter {c['closed_loop_flutter_speed']} m/s, peak hinge moment "
+        f"{c['hinge_moment_peak']} N m (fresh case); active: {', '.join(r.active) or 'none'}"
     )
     return 0 if r.success else 1
 

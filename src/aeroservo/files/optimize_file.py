@@ -31,7 +31,7 @@ from ..errors import MAX_ELEMENTS, InputError
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
 from .wing_file import wing_from_dict
 
-__all__ = ["OptimizationFile", "load_optimization"]
+__all__ = ["OptimizationFile", "CoDesignFile", "load_optimization", "load_codesign"]
 
 
 @dataclass(frozen=True)
@@ -91,4 +91,52 @@ def load_optimization(path: str | Path) -> OptimizationFile:
             variables=variables,
             objective=objective,
             constraints=constraints,
+        )
+
+
+@dataclass(frozen=True)
+class CoDesignFile:
+    """A validated co-design file: a trade scenario, a starting case, variables, a limit."""
+
+    name: str
+    scenario: object
+    start: dict
+    variables: dict
+    hinge_moment_peak_max: float | None
+
+
+def load_codesign(path: str | Path) -> CoDesignFile:
+    """Read a co-design file: ``[codesign]`` (``name``, ``scenario`` = a trade scenario),
+    ``[start]`` (the case, trade-parameter names), ``[variables]`` (``name = [lower, upper]``)
+    and ``[constraints]`` (``hinge_moment_peak_max`` [N m]); the objective is the closed-loop
+    flutter speed, maximized."""
+    from .scenario_file import load_scenario
+
+    data = read_toml(path, "co-design file (TOML)")
+    file = str(path)
+    with one_line_errors():
+        check_integers(data, file)
+        top = Table(data, "", file).check_keys(("codesign", "start", "variables"), ("constraints",))
+        cd = top.table("codesign").check_keys(("scenario",), ("name",))
+        sc_path = cd.path("scenario", Path(file).parent, required=True)
+        scenario = load_scenario(sc_path)
+        if scenario.kind != "trade":
+            cd.fail("scenario", cd.data["scenario"], f"a trade scenario, not {scenario.kind!r}")
+        start = {k: top.table("start").number(k) for k in top.table("start").data}
+        variables = {}
+        vt = top.table("variables")
+        for key in vt.data:
+            bounds = vt.numbers(key)
+            if len(bounds) != 2 or not bounds[0] < bounds[1]:
+                vt.fail(key, bounds, "expected [lower, upper], lower < upper")
+            if key not in start:
+                vt.fail(key, bounds, f"not in [start] {sorted(start)}")
+            variables[key] = tuple(bounds)
+        cons = top.table("constraints").check_keys((), ("hinge_moment_peak_max",))
+        return CoDesignFile(
+            name=cd.string("name", Path(file).stem),
+            scenario=scenario,
+            start=start,
+            variables=variables,
+            hinge_moment_peak_max=cons.number("hinge_moment_peak_max", quantity="limit"),
         )
