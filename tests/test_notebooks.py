@@ -26,6 +26,7 @@ EXPECTED = {
     "03_mpc_vs_saturated_lqr.ipynb",
     "04_trade_study.ipynb",
     "05_flutter_clearance.ipynb",
+    "06_sensitivities_and_tailoring.ipynb",
 }
 KERNEL = "python3"
 
