@@ -12,8 +12,6 @@ derivatives ``p / V dV/dp``.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 from test_stability_named import HALE, hale_wing
@@ -25,6 +23,7 @@ from aeroservo.stability.divergence import divergence_speed
 from aeroservo.stability.result import Crossing
 from aeroservo.stability.sensitivity import flutter_sensitivities, parameter_values
 from aeroservo.structure.examples import goland, goland_aileron
+from aeroservo.studies.optimize import with_parameters
 from aeroservo.system.assembly import assemble, structural_derivative
 
 TOL = 1e-4
@@ -40,20 +39,7 @@ divergence, ``divergence_critical_01``: 8e-4 with a step of 1e-4, 8e-6 with 1e-5
 
 def perturbed(wing: aes.Wing, name: str, h: float) -> aes.Wing:
     """The wing with parameter ``name`` (wing-file name) moved by ``h``."""
-    owner, idx, key, value = parameter_values(wing)[name]
-    if owner == "segment":
-        segs = list(wing.segments)
-        segs[idx[0]] = replace(segs[idx[0]], **{key: value + h})
-        return replace(wing, segments=tuple(segs))
-    surfaces = list(wing.control_surfaces)
-    cs = surfaces[idx[0]]
-    if owner == "surface":
-        surfaces[idx[0]] = replace(cs, **{key: value + h})
-    else:
-        acts = list(cs.actuators)
-        acts[idx[1]] = replace(acts[idx[1]], stiffness=value + h)
-        surfaces[idx[0]] = replace(cs, actuators=tuple(acts))
-    return replace(wing, control_surfaces=tuple(surfaces))
+    return with_parameters(wing, {name: parameter_values(wing)[name][3] + h})
 
 
 def _moved(model, density, name, value, h):

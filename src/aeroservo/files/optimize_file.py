@@ -48,6 +48,20 @@ class OptimizationFile:
     constraints: dict
 
 
+def _bounds(top: Table) -> dict:
+    """The ``[variables]`` table: ``name = [lower, upper]``, at least one."""
+    vt = top.table("variables")
+    variables = {}
+    for key in vt.data:
+        bounds = vt.numbers(key)
+        if len(bounds) != 2 or not bounds[0] < bounds[1]:
+            vt.fail(key, bounds, "expected [lower, upper], lower < upper")
+        variables[key] = tuple(bounds)
+    if not variables:
+        top.fail("variables", {}, "give at least one design variable")
+    return variables
+
+
 def load_optimization(path: str | Path) -> OptimizationFile:
     """Read and validate an optimization file (every error names the file and the key)."""
     data = read_toml(path, "optimization file (TOML)")
@@ -62,14 +76,7 @@ def load_optimization(path: str | Path) -> OptimizationFile:
             wing = wing_from_dict(data["wing"])
         except InputError as exc:
             raise InputError(f"{file}: {exc}") from None
-        variables = {}
-        for key in top.table("variables").data:
-            bounds = top.table("variables").numbers(key)
-            if len(bounds) != 2 or not bounds[0] < bounds[1]:
-                top.table("variables").fail(key, bounds, "expected [lower, upper], lower < upper")
-            variables[key] = tuple(bounds)
-        if not variables:
-            top.fail("variables", {}, "give at least one design variable")
+        variables = _bounds(top)
         ob = top.table("objective")
         if set(ob.data) == {"maximize"} and ob.data["maximize"] == "flutter_speed":
             objective = "flutter_speed"
@@ -123,15 +130,10 @@ def load_codesign(path: str | Path) -> CoDesignFile:
         if scenario.kind != "trade":
             cd.fail("scenario", cd.data["scenario"], f"a trade scenario, not {scenario.kind!r}")
         start = {k: top.table("start").number(k) for k in top.table("start").data}
-        variables = {}
-        vt = top.table("variables")
-        for key in vt.data:
-            bounds = vt.numbers(key)
-            if len(bounds) != 2 or not bounds[0] < bounds[1]:
-                vt.fail(key, bounds, "expected [lower, upper], lower < upper")
+        variables = _bounds(top)
+        for key, bounds in variables.items():
             if key not in start:
-                vt.fail(key, bounds, f"not in [start] {sorted(start)}")
-            variables[key] = tuple(bounds)
+                top.table("variables").fail(key, list(bounds), f"not in [start] {sorted(start)}")
         cons = top.table("constraints").check_keys((), ("hinge_moment_peak_max",))
         return CoDesignFile(
             name=cd.string("name", Path(file).stem),

@@ -21,7 +21,7 @@ from ..stability.boundary import flutter_boundary
 from ..stability.sensitivity import flutter_sensitivities, parameter_values
 from ..system.aeroelastic import AeroelasticModel
 
-__all__ = ["Optimization", "optimize_wing", "with_parameters"]
+__all__ = ["Optimization", "optimize_wing", "with_parameters", "design_variables"]
 
 ACTIVE = 1e-4
 """A constraint within this relative margin of its bound is reported active."""
@@ -117,11 +117,8 @@ def optimize_wing(
     from scipy.optimize import minimize
 
     table = parameter_values(wing)
-    names = _variables(variables, table)
-    lo = np.array([variables[n][0] for n in names], float)
-    hi = np.array([variables[n][1] for n in names], float)
-    p0 = np.clip([table[n][3] for n in names], lo, hi)
-    scale = np.where(p0 != 0, np.abs(p0), np.maximum(np.abs(hi), 1.0))
+    start = {n: v[3] for n, v in table.items()}
+    names, lo, hi, p0, scale = design_variables(variables, start, "of this wing")
     weights = _objective(objective, names)
     limits = _constraints(constraints)
     if gradients not in ("analytic", "central"):
@@ -224,17 +221,28 @@ def optimize_wing(
     )
 
 
-def _variables(variables: object, table: dict) -> list[str]:
+def design_variables(variables: object, start: dict, owner: str) -> tuple:
+    """Checked design variables ``{name: (lower, upper)}`` with their starting values.
+
+    Returns ``(names, lower, upper, x0, scale)``: the start clipped into the bounds, and the
+    scale of each variable (its start, or ``max(|upper|, 1)`` for a zero start) that SLSQP
+    works in. ``owner`` names what ``start`` describes, for messages.
+    """
     if not isinstance(variables, dict) or not variables:
         raise InputError(f"variables = {variables!r}: expected {{name: (lower, upper)}}")
     for n, b in variables.items():
-        if n not in table:
-            raise InputError(f"variables: {n!r} is not a parameter of this wing")
+        if n not in start:
+            raise InputError(f"variables: {n!r} is not a parameter {owner} {list(start)[:8]}")
         if not isinstance(b, (list, tuple)) or len(b) != 2:
             raise InputError(f"variables[{n!r}] = {b!r}: expected [lower, upper]")
         a = check_number(f"variables[{n!r}][0]", b[0])
         check_number(f"variables[{n!r}][1]", b[1], lo=a, lo_open=True)
-    return list(variables)
+    names = list(variables)
+    lo = np.array([variables[n][0] for n in names], float)
+    hi = np.array([variables[n][1] for n in names], float)
+    x0 = np.clip([float(start[n]) for n in names], lo, hi)
+    scale = np.where(x0 != 0, np.abs(x0), np.maximum(np.abs(hi), 1.0))
+    return names, lo, hi, x0, scale
 
 
 def _objective(objective: object, names: list[str]) -> np.ndarray | None:

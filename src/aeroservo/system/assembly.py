@@ -107,8 +107,7 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     # unknowns in an extended numbering: the clamped root (w, theta, phi) get the last 3 indices,
     # so one scatter gives both the free matrices and the root-reaction rows
     n_q = mesh.n_dofs
-    edofs = mesh.element_dofs.copy()
-    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
+    edofs = _extended_dofs(mesh)
     n_x = n_q + 3
     n_n = mesh.n_nodes
     lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
@@ -195,6 +194,15 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
         stiffness_parts=parts,
         root=root,
     )
+
+
+def _extended_dofs(mesh: Mesh) -> np.ndarray:
+    """Element unknowns with the clamped root's (w, theta, phi) numbered n_q, n_q+1, n_q+2, so
+    one scatter gives the free matrices and the root rows."""
+    n_q = mesh.n_dofs
+    edofs = mesh.element_dofs.copy()
+    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
+    return edofs
 
 
 def _unit(i: int) -> np.ndarray:
@@ -293,8 +301,7 @@ def structural_derivative(
     L = mesh.lengths
     xi, wts = gauss_rule()
     N, D, _ = field_shapes(L, xi)
-    edofs = mesh.element_dofs.copy()
-    edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]  # the clamped root, dropped below
+    edofs = _extended_dofs(mesh)  # the clamped root, dropped below
     shape = (n_q + 3, n_q + 3)
 
     def qq(coef, left, right):

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError, check_number
+from ..optimize import design_variables
 from .cases import evaluate_case
 from .sensitivity import case_sensitivities
 from .study import PARAMETERS, TradeStudy
@@ -81,16 +82,8 @@ def codesign(
     """
     from scipy.optimize import minimize
 
-    names = list(bounds)
-    for n in names:
-        if n not in PARAMETERS or n not in start:
-            raise InputError(f"variables: {n!r} is not a parameter of the case {list(start)}")
-    lo = np.array([check_number(f"variables[{n!r}][0]", bounds[n][0]) for n in names])
-    hi = np.array([check_number(f"variables[{n!r}][1]", bounds[n][1]) for n in names])
-    if np.any(hi <= lo):
-        raise InputError(f"variables = {bounds!r}: each needs lower < upper")
-    x0 = np.clip([float(start[n]) for n in names], lo, hi)
-    scale = np.where(x0 != 0, np.abs(x0), 1.0)
+    case_parameters = {k: v for k, v in start.items() if k in PARAMETERS}
+    names, lo, hi, x0, scale = design_variables(bounds, case_parameters, "of the case")
     limit = None
     if hinge_moment_peak_max is not None:
         limit = check_number(
