@@ -144,3 +144,63 @@ def test_codesign_shipped_case(capsys):
     )
     slope = s.derivatives["closed_loop_flutter_speed"]["aileron_chord"]
     assert abs(slope * chord / out["closed_loop_flutter_speed"]) < 1e-2
+
+
+# -- the shipped mass-balance case ---------------------------------------------------------------
+BALANCE = ROOT / "scenarios" / "optimize_goland_mass_balance.toml"
+S_BETA = "control_surfaces[0].static_moment"
+
+
+@pytest.fixture(scope="module")
+def balance():
+    p = load_optimization(BALANCE)
+    return p, {
+        g: optimize_wing(
+            p.wing,
+            p.density,
+            p.variables,
+            p.objective,
+            p.constraints,
+            damping=p.damping,
+            gradients=g,
+        )
+        for g in ("analytic", "central")
+    }
+
+
+def test_mass_balance_least_balance_bracketed(balance):
+    """The least balance (largest S_beta) with V_f >= 126.5 m/s (g = 0.02): the optimum meets
+    the constraint on a fresh analysis, and 1e-3 kg m/m less balance breaks it (independent of
+    the optimizer: the flutter speed falls as S_beta grows here)."""
+    p, sol = balance
+    a, c = sol["analytic"], sol["central"]
+    assert a.success and c.success and a.active == ["flutter_speed_min"]
+    assert a.variables[S_BETA] == pytest.approx(c.variables[S_BETA], abs=1e-6)
+    assert a.n_boundaries < c.n_boundaries
+    assert all(it["gradients"] == "analytic" for it in a.iterations)
+    s = a.variables[S_BETA]
+    assert -0.6 < s < -0.4 + 0.4  # inside the bounds: balance is needed, less than at the start
+
+    def vf(x):
+        model = aes.AeroelasticModel(with_parameters(p.wing, {S_BETA: x}), damping=p.damping)
+        return aes.flutter_boundary(model, p.density).flutter_speed
+
+    assert vf(s) >= 126.5 * (1 - 1e-6) and vf(s + 1e-3) < 126.5
+
+
+def test_negative_weights_keep_the_direction(balance):
+    """A negative weight maximizes its variable, whatever the sign of the start (the
+    objective is scaled by its magnitude, not its sign)."""
+    p, sol = balance
+    assert sol["analytic"].objective == pytest.approx(-sol["analytic"].variables[S_BETA])
+    assert sol["analytic"].variables[S_BETA] > p.wing.control_surfaces[0].static_moment
+
+
+def test_an_actuator_on_a_node_falls_back_to_central_differences():
+    """The actuator station of the Goland aileron sits on a mesh node, where the analytic
+    derivative does not exist: that iterate's gradient is a central difference, and says so."""
+    wing = aes.examples.goland_aileron()
+    name = "control_surfaces[0].actuators[0].station"
+    r = optimize_wing(wing, 1.225, {name: (3.9, 4.6)}, "flutter_speed", {}, max_iterations=1)
+    first = r.iterations[0]
+    assert first["gradients"].startswith("central") and "mesh node" in first["gradients"]

@@ -23,6 +23,7 @@ __all__ = [
     "Atmosphere",
     "isa",
     "isa_ft",
+    "isa_slopes",
     "FT",
     "KNOT",
     "RHO0",
@@ -132,6 +133,24 @@ def isa(altitude: float, *, geometric: bool = False) -> Atmosphere:
     T, p = _layer_state(h)
     rho = p / (R_AIR * T)
     return Atmosphere(h, T, p, rho, math.sqrt(GAMMA * R_AIR * T))
+
+
+def isa_slopes(atmosphere: Atmosphere) -> tuple[float, float]:
+    """Derivatives of density and speed of sound with geopotential altitude.
+
+    From the hydrostatic equation and the ideal gas, ``drho/dH = -rho (g0 / (R T) + T' / T)``
+    and ``da/dH = a T' / (2 T)``, with the lapse rate ``T'`` of the layer (at a layer's top the
+    layer below, as in :func:`isa`; there the slopes have a kink).
+
+    Returns
+    -------
+    (drho_dH, da_dH) : float
+        [kg/m^3 per m], [1/s].
+    """
+    h, T = atmosphere.altitude, atmosphere.temperature
+    lapse = next(lp for base, lp in reversed(_LAYERS) if h > base or base == 0.0)
+    drho = -atmosphere.density * (G0 / (R_AIR * T) + lapse / T)
+    return drho, atmosphere.speed_of_sound * lapse / (2.0 * T)
 
 
 def isa_ft(altitude_ft: float, *, geometric: bool = False) -> Atmosphere:

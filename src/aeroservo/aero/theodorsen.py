@@ -114,6 +114,13 @@ def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
     return out if out.ndim else complex(out)
 
 
+def _real_or_complex(x) -> np.ndarray:
+    """``x`` as a float array, or a complex one when given complex (complex-step derivatives
+    of the coefficients, :mod:`aeroservo.system.derivatives`)."""
+    x = np.asarray(x)
+    return x.astype(complex if np.iscomplexobj(x) else float)
+
+
 def t_functions(c: np.ndarray | float, a: np.ndarray | float) -> dict[str, np.ndarray]:
     """Theodorsen's flap geometry functions T1..T14.
 
@@ -121,7 +128,8 @@ def t_functions(c: np.ndarray | float, a: np.ndarray | float) -> dict[str, np.nd
     ----------
     c : array_like
         Hinge position in semichords aft of mid-chord [-], -1 <= c <= 1. c = 1 is a
-        zero-chord flap, for which every T vanishes except T14.
+        zero-chord flap, for which every T vanishes except T14. Complex values (a complex
+        step) are evaluated without clipping.
     a : array_like
         Elastic-axis position in semichords aft of mid-chord [-].
 
@@ -130,11 +138,12 @@ def t_functions(c: np.ndarray | float, a: np.ndarray | float) -> dict[str, np.nd
     dict
         Keys ``"T1"`` .. ``"T14"``, arrays broadcast from ``c`` and ``a``.
     """
-    c = np.asarray(c, dtype=float)
-    a = np.asarray(a, dtype=float)
-    c, a = np.broadcast_arrays(c, a)
-    th = np.arccos(np.clip(c, -1.0, 1.0))
-    s = np.sqrt(np.clip(1.0 - c**2, 0.0, None))
+    c, a = np.broadcast_arrays(_real_or_complex(c), _real_or_complex(a))
+    if np.iscomplexobj(c):  # a complex step (derivatives): -1 < Re c < 1 where it moves
+        th, s = np.arccos(c), np.sqrt(1.0 - c**2)
+    else:
+        th = np.arccos(np.clip(c, -1.0, 1.0))
+        s = np.sqrt(np.clip(1.0 - c**2, 0.0, None))
     t = {}
     t["T1"] = -s * (2.0 + c**2) / 3.0 + c * th
     t["T2"] = c * (1.0 - c**2) - s * (1.0 + c**2) * th + c * th**2
@@ -217,9 +226,7 @@ def section_aero(
     -------
     SectionAero
     """
-    b, a, c = np.broadcast_arrays(
-        np.asarray(b, dtype=float), np.asarray(a, dtype=float), np.asarray(c, dtype=float)
-    )
+    b, a, c = np.broadcast_arrays(_real_or_complex(b), _real_or_complex(a), _real_or_complex(c))
     T = t_functions(c, a)
     pi = np.pi
     z = np.zeros_like(b)

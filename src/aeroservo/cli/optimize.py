@@ -42,6 +42,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         op.objective,
         op.constraints,
         n_elements=op.elements,
+        damping=op.damping,
         v_max=op.v_max,
         gradients=args.gradients,
     )

@@ -17,8 +17,10 @@ def add_parsers(sub) -> None:
         help="derivatives of the flutter and divergence speeds to every wing parameter",
         description="Analytic sensitivities (left and right eigenvectors at the crossing, matrix "
         "derivatives from the element integrals): dV_f/dp, df_f/dp and dV_d/dp for every "
-        "segment, control-surface and actuator parameter and the density, named as in the "
-        "wing file, in SI units per unit of the parameter.",
+        "segment, control-surface and actuator parameter named as in the wing file, the "
+        "structural damping's own parameters, the density, and the altitude (with --altitude; "
+        "at the matched Mach number with --compressibility), in SI units per unit of the "
+        "parameter.",
     )
     p.add_argument("wing", help="built-in wing, a wing .toml or a scenario .toml")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -36,15 +38,16 @@ def _cmd_sensitivity(args: argparse.Namespace) -> int:
     _check_figure(args.plot)
     check_int("--top", args.top, lo=1, hi=1000)
     s = setup(args)
-    if s.atmosphere is not None and s.compressibility:
-        from ..errors import InputError
-
-        raise InputError("--compressibility: sensitivities are for the incompressible model")
     from ..stability.sensitivity import flutter_sensitivities
 
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
+    kw = {"v_max": v_max, "n_modes": s.opts.n_modes}
+    if s.atmosphere is not None:
+        kw.update(atmosphere=s.atmosphere, compressibility=s.compressibility)
+    else:
+        kw["density"] = s.density
     with named("n_modes", None, args, "n_modes"):
-        sens = flutter_sensitivities(s.model, s.density, v_max=v_max, n_modes=s.opts.n_modes)
+        sens = flutter_sensitivities(s.model, **kw)
     if args.plot:
         from ..atomic import save_figure
         from ..plots.sensitivity import plot_sensitivities
@@ -65,8 +68,13 @@ def _text(name: str, sens) -> str:
     def f(v):
         return "-" if v is None else f"{v:.6g}"
 
+    where = f"{sens.density:.5g} kg/m^3"
+    if sens.altitude is not None:
+        where = f"{sens.altitude:.6g} m ({where})"
+    if sens.mach:
+        where += f", Mach {sens.mach:.4g}" + (" (matched)" if sens.matched else "")
     lines = [
-        f"{name} at {sens.density:.5g} kg/m^3: flutter {f(sens.flutter_speed)} m/s, "
+        f"{name} at {where}: flutter {f(sens.flutter_speed)} m/s, "
         f"{f(sens.flutter_frequency)} Hz; divergence {f(sens.divergence_speed)} m/s",
         f"{'parameter':44s} {'value':>11s} {'dV_f/dp':>12s} {'(p/V)dV_f/dp':>13s} "
         f"{'df_f/dp':>12s} {'dV_d/dp':>12s}",
@@ -77,6 +85,7 @@ def _text(name: str, sens) -> str:
             f"{k:44s} {v:11.5g} {f(sens.d_flutter_speed.get(k)):>12s} {f(norm.get(k)):>13s} "
             f"{f(sens.d_flutter_frequency.get(k)):>12s} {f(sens.d_divergence_speed.get(k)):>12s}"
         )
+    lines += [f"no derivative for {k}: {why}" for k, why in sens.undefined.items()]
     return "\n".join(lines)
 
 

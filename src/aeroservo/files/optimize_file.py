@@ -15,10 +15,13 @@ v_max = 300.0            # m/s, optional top of each speed search
 "segments[0].GJ" = [3.0e5, 3.0e6]
 
 [objective]              # minimize = {variable = weight}  or  maximize = "flutter_speed"
-minimize = { "segments[0].GJ" = 3.048 }
+minimize = { "segments[0].GJ" = 3.048 }   # a negative weight maximizes the variable
 
 [constraints]            # m/s
 flutter_speed_min = 150.0
+
+[damping]                # optional: structural damping, as in a wing file (g, ratio, alpha/beta)
+g = 0.02
 ```
 """
 
@@ -29,7 +32,7 @@ from pathlib import Path
 
 from ..errors import MAX_ELEMENTS, InputError
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
-from .wing_file import wing_from_dict
+from .wing_file import damping_from_dict, wing_from_dict
 
 __all__ = ["OptimizationFile", "CoDesignFile", "load_optimization", "load_codesign"]
 
@@ -46,6 +49,7 @@ class OptimizationFile:
     variables: dict
     objective: object
     constraints: dict
+    damping: object = None
 
 
 def _bounds(top: Table) -> dict:
@@ -69,7 +73,7 @@ def load_optimization(path: str | Path) -> OptimizationFile:
     with one_line_errors():
         check_integers(data, file)
         top = Table(data, "", file).check_keys(
-            ("optimize", "wing", "variables", "objective", "constraints")
+            ("optimize", "wing", "variables", "objective", "constraints"), ("damping",)
         )
         op = top.table("optimize").check_keys(("density",), ("name", "elements", "v_max"))
         try:
@@ -82,13 +86,19 @@ def load_optimization(path: str | Path) -> OptimizationFile:
             objective = "flutter_speed"
         else:
             mn = ob.check_keys(("minimize",)).table("minimize")
-            objective = {k: mn.check_value(k, v, lo=0.0) for k, v in mn.data.items()}
+            objective = {k: mn.check_value(k, v) for k, v in mn.data.items()}
             if not objective:
                 mn.fail(None, {}, "give at least one variable and its weight")
         cons = top.table("constraints").check_keys(
             (), ("flutter_speed_min", "divergence_speed_min")
         )
         constraints = {k: cons.number(k, quantity="flight_speed") for k in cons.data}
+        damping = None
+        if "damping" in data:
+            try:
+                damping = damping_from_dict(top.table("damping").data, "damping")
+            except InputError as exc:
+                raise InputError(f"{file}: {exc}") from None
         return OptimizationFile(
             name=op.string("name", Path(file).stem),
             wing=wing,
@@ -98,6 +108,7 @@ def load_optimization(path: str | Path) -> OptimizationFile:
             variables=variables,
             objective=objective,
             constraints=constraints,
+            damping=damping,
         )
 
 

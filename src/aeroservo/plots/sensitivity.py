@@ -54,9 +54,12 @@ def plot_sensitivities(s: FlutterSensitivities, *, top: int = 20, title: str = "
     ax.axvline(0.0, color="k", lw=0.8)
     ax.set_xlabel("normalized sensitivity  (p / V) dV/dp  [% of speed per % of parameter]")
     note = f" (flutter: {s.non_differentiable})" if s.non_differentiable else ""
-    ax.set_title(
-        (title or "Speed sensitivities") + f", rho = {s.density:.4g} kg/m^3" + note, fontsize=9
-    )
+    where = f", rho = {s.density:.4g} kg/m^3"
+    if s.altitude is not None:
+        where = f", {s.altitude:.5g} m ({s.density:.4g} kg/m^3)"
+    if s.mach:
+        where += f", Mach {s.mach:.3g}" + (" matched" if s.matched else "")
+    ax.set_title((title or "Speed sensitivities") + where + note, fontsize=9)
     if flutter or div:
         ax.legend(fontsize=8, loc="best")
     ax.grid(axis="x", alpha=0.3)

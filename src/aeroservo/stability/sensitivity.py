@@ -12,33 +12,38 @@ and, since ``Re lambda(V_f(p), p) = 0`` along the boundary,
     dV_f/dp = -Re(dlambda/dp) / Re(dlambda/dV),
     d omega_f/dp = Im(dlambda/dp) + Im(dlambda/dV) dV_f/dp.
 
-The matrix derivatives come from the element integrals of the derivatives of the section
-matrices (:func:`aeroservo.system.assembly.structural_derivative`; the structural matrices are
-linear in every parameter offered here, so the derivatives are exact). The divergence speed
-``V_d`` solves ``(Ks + rho V_d^2 K_static) q = 0``; with left and right null vectors ``u``, ``q``:
-``d(V_d^2)/dp = -u^T (dKs/dp) q / (rho u^T K_static q)``.
+``dE/dp`` and ``dP/dp`` are the pencil (:func:`aeroservo.system.first_order.pencil_blocks`, linear
+in the matrices) of the matrix derivatives (:mod:`aeroservo.system.derivatives`: element
+integrals of the derivatives of the section coefficients), structural damping's derivative
+included (:func:`aeroservo.system.damping.damping_derivatives`). With the Prandtl-Glauert
+correction at a matched Mach number ``M = V / a`` the speed derivative is the total one,
+``dlambda/dV + (dlambda/dM) / a``; the altitude moves the density and the speed of sound
+(:func:`aeroservo.aero.atmosphere.isa_slopes`).
 
-All sensitivities together cost one flutter boundary plus two sparse factorizations, whatever
-the number of parameters. Where the flutter speed is not differentiable (two branches cross
+The divergence speed ``V_d`` solves ``(Ks + rho V_d^2 K_static) q = 0``,
+``K_static = Ka - Dz Lam^-1 Ez``; with left and right null vectors ``u``, ``q`` of that matrix
+``F``: ``dV_d/dp = -(u^T dF/dp q) / (u^T dF/dV q)``.
+
+All sensitivities together cost one flutter boundary plus two sparse factorizations and one
+sparse pencil per parameter. Where the flutter speed is not differentiable (two branches cross
 within ``TIE`` of each other: a mode switch; or a branch that only touches the axis, a hump
-whose crossing speed has an infinite slope) the result says so instead of giving a number.
+whose crossing speed has an infinite slope) the result says so instead of giving a number; a
+parameter without a derivative of its own (an actuator on a mesh node, a kink of the discretized
+model) is listed in ``undefined`` with its one-sided derivatives.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-
 from ..errors import InputError
 from ..system.aeroelastic import AeroelasticModel
-from ..system.assembly import STRUCTURAL_PARAMETERS, structural_derivative
-from .boundary import flutter_boundary
+from ..system.damping import damping_parameters
+from ..system.derivatives import PARAMETERS
 from .result import FlutterResult
+from .sensitivity_terms import Terms
 
-__all__ = ["FlutterSensitivities", "flutter_sensitivities", "parameter_values", "TIE"]
+__all__ = ["FlutterSensitivities", "flutter_sensitivities", "parameter_values", "TIE", "TOUCH"]
 
 TIE = 1e-3
 """Two onsets closer than this relative speed: a mode switch, not differentiable."""
@@ -48,17 +53,18 @@ TOUCH = 1e-5
 
 
 def parameter_values(wing) -> dict[str, tuple[str, tuple[int, ...], str, float]]:
-    """Every parameter offered, by its wing-file name, with ``(owner, index, key, value)``."""
+    """Every wing parameter offered, by its wing-file name, with ``(owner, index, key, value)``."""
     out: dict = {}
     for i, seg in enumerate(wing.segments):
-        for key in STRUCTURAL_PARAMETERS["segment"]:
+        for key in PARAMETERS["segment"]:
             out[f"segments[{i}].{key}"] = ("segment", (i,), key, float(getattr(seg, key)))
     for k, cs in enumerate(wing.control_surfaces):
-        for key in STRUCTURAL_PARAMETERS["surface"]:
+        for key in PARAMETERS["surface"]:
             out[f"control_surfaces[{k}].{key}"] = ("surface", (k,), key, float(getattr(cs, key)))
         for j, act in enumerate(cs.actuators):
-            name = f"control_surfaces[{k}].actuators[{j}].stiffness"
-            out[name] = ("actuator", (k, j), "stiffness", float(act.stiffness))
+            for key in PARAMETERS["actuator"]:
+                name = f"control_surfaces[{k}].actuators[{j}].{key}"
+                out[name] = ("actuator", (k, j), key, float(getattr(act, key)))
     return out
 
 
@@ -71,14 +77,20 @@ class FlutterSensitivities:
     flutter_speed, flutter_frequency, divergence_speed : float or None
         [m/s], [Hz], [m/s] of the analysis the derivatives belong to.
     values : dict
-        Parameter name -> its value (wing-file units; ``density`` in kg/m^3).
+        Parameter name -> its value (wing-file units; ``density`` in kg/m^3, ``altitude`` in m,
+        ``mach``, ``damping.*`` as in the damping table).
     d_flutter_speed, d_flutter_frequency, d_divergence_speed : dict
         Parameter name -> derivative [m/s or Hz per unit of the parameter]; empty when the
         speed does not exist or is not differentiable.
     non_differentiable : str or None
         Why the flutter speed has no derivative here (None: it has one).
+    undefined : dict
+        Parameter name -> why it has no derivative (with its one-sided derivatives).
     density : float
         Air density [kg/m^3].
+    altitude, mach : float or None
+        Geopotential altitude [m] of an atmosphere-based analysis, Mach number of the
+        aerodynamics (0: incompressible); ``matched``: the Mach number follows the speed.
     """
 
     flutter_speed: float | None
@@ -89,7 +101,11 @@ class FlutterSensitivities:
     d_flutter_frequency: dict = field(default_factory=dict)
     d_divergence_speed: dict = field(default_factory=dict)
     non_differentiable: str | None = None
+    undefined: dict = field(default_factory=dict)
     density: float = 1.225
+    altitude: float | None = None
+    mach: float = 0.0
+    matched: bool = False
 
     def normalized(self) -> dict[str, float]:
         """``p / V_f dV_f/dp`` per parameter [-]: the % change of V_f per % of p."""
@@ -103,7 +119,11 @@ class FlutterSensitivities:
             "flutter_frequency": self.flutter_frequency,
             "divergence_speed": self.divergence_speed,
             "density": self.density,
+            "altitude": self.altitude,
+            "mach": self.mach,
+            "matched_mach": self.matched,
             "non_differentiable": self.non_differentiable,
+            "undefined": dict(self.undefined),
             "values": dict(self.values),
             "d_flutter_speed": dict(self.d_flutter_speed),
             "d_flutter_frequency": dict(self.d_flutter_frequency),
@@ -121,6 +141,8 @@ def flutter_sensitivities(
     density: float | None = None,
     parameters: list[str] | None = None,
     *,
+    atmosphere=None,
+    compressibility: str | None = None,
     result: FlutterResult | None = None,
     rtol: float = 1e-10,
     **kw,
@@ -130,20 +152,26 @@ def flutter_sensitivities(
     Parameters
     ----------
     model : AeroelasticModel
-        The wing's model (incompressible; structural damping not yet supported for the
-        structural parameters).
+        The wing's model (structural damping of any kind included).
     density : float
-        Air density [kg/m^3].
+        Air density [kg/m^3]; or give ``atmosphere``.
     parameters : list of str, optional
-        Names as in the wing file (``"segments[0].GJ"``,
-        ``"control_surfaces[0].actuators[1].stiffness"``, ``"density"``); default all of
-        :func:`parameter_values` and ``density``.
+        Names as in the wing file (``"segments[0].GJ"``, ``"segments[0].a"``,
+        ``"control_surfaces[0].hinge"``, ``"control_surfaces[0].actuators[1].station"``), the
+        damping's (``"damping.g"``, ``"damping.ratio"``, ``"damping.alpha"``), and the flight
+        condition's (``"density"``; ``"altitude"`` with an atmosphere; ``"mach"`` at a fixed
+        Mach number); default all of them.
+    atmosphere : Atmosphere, optional
+        A standard-atmosphere flight condition (:func:`aeroservo.aero.atmosphere.isa`).
+    compressibility : {None, "prandtl-glauert"}
+        With ``atmosphere``: the Prandtl-Glauert correction at the matched Mach number.
     result : FlutterResult, optional
-        The boundary at this density, if already computed (else computed with ``rtol``).
+        The boundary at this flight condition, if already computed (else computed with
+        ``rtol``).
     rtol : float
         Tolerance of the boundary's crossing speeds (tight: the derivative is taken there).
     **kw
-        Passed to :func:`aeroservo.flutter_boundary` (``v_max``, ``n_modes``).
+        Passed to :func:`aeroservo.flutter_boundary` (``v_max``, ``n_modes``, ``mach``).
 
     Returns
     -------
@@ -151,48 +179,72 @@ def flutter_sensitivities(
     """
     if not isinstance(model, AeroelasticModel):
         raise InputError(f"model = {type(model).__name__}: expected an aeroservo.AeroelasticModel")
-    if density is None:
-        raise InputError("density = None: give the air density [kg/m^3]")
+    if result is None:
+        result = _boundary(model, density, atmosphere, compressibility, rtol, kw)
+    r = result
+    matched = "matched" in r.info
+    flight = {"density": r.density}
+    if r.altitude is not None:
+        flight["altitude"] = r.altitude
+    if r.mach and not matched:
+        flight["mach"] = r.mach
     table = parameter_values(model.wing)
-    names = list(table) + ["density"] if parameters is None else _checked(parameters, table)
-    if model.damping.active and any(n != "density" for n in names):
-        raise InputError(
-            f"damping = {model.damping.describe()!r}: sensitivities to structural parameters "
-            "are available for undamped models only (for now); density is available"
-        )
-    r = result if result is not None else flutter_boundary(model, density, rtol=rtol, **kw)
-    if r.mach:
-        raise InputError(f"mach = {r.mach:g}: sensitivities are for the incompressible model")
-    system = model.system(r.density)
-    values = {n: (table[n][3] if n != "density" else r.density) for n in names}
+    own = damping_parameters(model.damping)
+    known = {**{n: v[3] for n, v in table.items()}, **own, **flight}
+    names = list(known) if parameters is None else _checked(parameters, known)
     out = FlutterSensitivities(
-        r.flutter_speed, r.flutter_frequency, r.divergence_speed, values, density=r.density
+        r.flutter_speed,
+        r.flutter_frequency,
+        r.divergence_speed,
+        {n: known[n] for n in names},
+        density=r.density,
+        altitude=r.altitude,
+        mach=r.mach,
+        matched=matched,
     )
-    derivs = {n: _matrices(model, table, n) for n in names if n != "density"}
+    terms = Terms(model, r, matched)
+    for name in names:
+        why = terms.add(name, table.get(name))
+        if why:
+            out.undefined[name] = why
     if r.flutter_speed is not None:
         out.non_differentiable = _tie(r)
         if out.non_differentiable is None:
-            _flutter(out, model, system, r, names, derivs)
+            out.non_differentiable = terms.flutter(out, TOUCH)
     if r.divergence_speed is not None:
-        _divergence(out, system, r, names, derivs)
+        terms.divergence(out)
     return out
 
 
-def _checked(parameters: object, table: dict) -> list[str]:
+def _boundary(model, density, atmosphere, compressibility, rtol, kw) -> FlutterResult:
+    from .boundary import flutter_boundary
+
+    if atmosphere is None:
+        if density is None:
+            raise InputError("density = None: give the air density [kg/m^3] or an atmosphere")
+        if compressibility not in (None, "none"):
+            raise InputError(
+                f"compressibility = {compressibility!r}: needs the speed of sound, give an "
+                "atmosphere instead of a density"
+            )
+        return flutter_boundary(model, density, rtol=rtol, **kw)
+    if density is not None:
+        raise InputError("density and atmosphere: give one of them")
+    from .matched import flutter_at
+
+    return flutter_at(model, atmosphere, compressibility=compressibility, rtol=rtol, **kw)
+
+
+def _checked(parameters: object, known: dict) -> list[str]:
     if isinstance(parameters, str) or not isinstance(parameters, (list, tuple)):
         raise InputError(f"parameters = {parameters!r}: expected a list of parameter names")
     for p in parameters:
-        if p != "density" and p not in table:
+        if p not in known:
             raise InputError(
-                f"parameters: {p!r} is not a parameter of this wing; known: "
-                f"{[*list(table)[:6], '...', 'density']}"
+                f"parameters: {p!r} is not a parameter of this analysis; known: "
+                f"{[*list(known)[:6], '...', *[k for k in known if '[' not in k]]}"
             )
     return list(parameters)
-
-
-def _matrices(model, table: dict, name: str) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    owner, index, key, _ = table[name]
-    return structural_derivative(model.wing, model.mesh, owner, index, key)
 
 
 def _tie(r: FlutterResult) -> str | None:
@@ -207,68 +259,3 @@ def _tie(r: FlutterResult) -> str | None:
             f"{c.speed:.6g} m/s (within {TIE:g}); V_f is the smaller of two smooth functions"
         )
     return None
-
-
-def _eigenpair(system, speed: float, sigma: complex) -> tuple[complex, np.ndarray, np.ndarray]:
-    """Eigenvalue near ``sigma`` of the pencil at ``speed`` with right and left vectors, by
-    shift-and-invert iteration on sparse factorizations (two shifts)."""
-    E = system.E.astype(complex)
-    P = system.pencil(speed).astype(complex)
-    n = E.shape[0]
-    rng = np.random.default_rng(0)
-    x = rng.standard_normal(n) + 1j * rng.standard_normal(n)
-    y = x.copy()
-    lam = sigma
-    for its in (6, 4):
-        lu = spla.splu((P - lam * E).tocsc())
-        for _ in range(its):
-            x = lu.solve(E @ x)
-            x /= np.linalg.norm(x)
-            y = lu.solve(E.conj().T @ y, trans="H")
-            y /= np.linalg.norm(y)
-        lam = (y.conj() @ (P @ x)) / (y.conj() @ (E @ x))
-    res = np.linalg.norm(P @ x - lam * (E @ x)) / max(spla.norm(P, 1), 1.0)
-    if res > 1e-8:
-        raise RuntimeError(f"flutter eigenpair not converged (residual {res:.1e})")
-    return lam, x, y
-
-
-def _flutter(out, model, system, r: FlutterResult, names, derivs) -> None:
-    vf, n_q = r.flutter_speed, system.n_q
-    lam, x, y = _eigenpair(system, vf, 2j * np.pi * r.flutter_frequency)
-    den = y.conj() @ (system.E @ x)
-    dl_dv = (y.conj() @ (system.d_pencil(vf) @ x)) / den
-    if dl_dv.real * vf / abs(lam) < TOUCH:
-        out.non_differentiable = (
-            f"the branch only touches the axis at {vf:.6g} m/s (dRe(lambda)/dV = "
-            f"{dl_dv.real:.3g} 1/m): a hump, the flutter speed jumps"
-        )
-        return
-    xq, xv = x[:n_q], x[n_q : 2 * n_q]
-    yv = y[n_q : 2 * n_q].conj()
-    for name in names:
-        if name == "density":  # M = Ms + rho Mnc; the speed terms of the v-rows are x rho
-            rows = sp.diags(np.r_[np.zeros(n_q), np.ones(n_q), np.zeros(system.n_states - 2 * n_q)])
-            d_pencil = rows @ (vf * system.A1 + vf * vf * system.A2) / r.density
-            d_e = yv @ (model.matrices.Mnc @ xv)
-            dl = (y.conj() @ (d_pencil @ x) - lam * d_e) / den
-        else:
-            dM, dK = derivs[name]
-            dl = (-(yv @ (dK @ xq)) - lam * (yv @ (dM @ xv))) / den
-        dv = -dl.real / dl_dv.real
-        out.d_flutter_speed[name] = float(dv)
-        out.d_flutter_frequency[name] = float((dl.imag + dl_dv.imag * dv) / (2.0 * np.pi))
-
-
-def _divergence(out, system, r: FlutterResult, names, derivs) -> None:
-    vd, rho = r.divergence_speed, r.density
-    K = system.Ks.toarray() + rho * vd * vd * system.K_static
-    U, _, Vh = np.linalg.svd(K)
-    u, q = U[:, -1], Vh[-1]
-    den = rho * (u @ system.K_static @ q)
-    for name in names:
-        if name == "density":  # rho V_d^2 is fixed
-            out.d_divergence_speed[name] = float(-vd / (2.0 * rho))
-        else:
-            d_mu = -(u @ (derivs[name][1] @ q)) / den
-            out.d_divergence_speed[name] = float(d_mu / (2.0 * vd))

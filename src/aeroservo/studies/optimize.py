@@ -72,7 +72,7 @@ def with_parameters(wing, values: dict):
         else:
             cs = surfaces[idx[0]]
             acts = list(cs.actuators)
-            acts[idx[1]] = replace(acts[idx[1]], stiffness=v)
+            acts[idx[1]] = replace(acts[idx[1]], **{key: v})
             surfaces[idx[0]] = replace(cs, actuators=tuple(acts))
     return replace(wing, segments=tuple(segs), control_surfaces=tuple(surfaces))
 
@@ -86,6 +86,7 @@ def optimize_wing(
     *,
     n_elements: int = 10,
     wagner: object = "rt_jones",
+    damping=None,
     v_max: float | None = None,
     gradients: str = "analytic",
     max_iterations: int = 60,
@@ -104,10 +105,13 @@ def optimize_wing(
         ``{name: weight}``: minimize ``sum weight * value``; ``"flutter_speed"``: maximize it.
     constraints : dict
         ``flutter_speed_min`` and/or ``divergence_speed_min`` [m/s].
-    n_elements, wagner, v_max
-        The model and the top of each speed search.
+    n_elements, wagner, damping, v_max
+        The model (structural damping: a StructuralDamping or None) and the top of each speed
+        search.
     gradients : {"analytic", "central"}
         Analytic sensitivities, or central differences (relative step 1e-5) for comparison.
+        Where an analytic derivative does not exist at an iterate (a mode switch, an actuator
+        on a mesh node) that iterate's gradient is a central difference, and its log says why.
     max_iterations : int
 
     Returns
@@ -128,23 +132,28 @@ def optimize_wing(
     log: list = []
     count = [0]
 
+    def make(w):
+        return AeroelasticModel(w, n_elements, wagner, damping=damping)
+
     def analyse(x: np.ndarray):
         key = tuple(np.round(x, 14))
         if key not in cache:
             p = x * scale
-            model = AeroelasticModel(
-                with_parameters(wing, dict(zip(names, p, strict=True))), n_elements, wagner
-            )
+            how = gradients
             if gradients == "analytic":
                 count[0] += 1
-                s = flutter_sensitivities(model, density, [*names], v_max=v_max)
+                moved = with_parameters(wing, dict(zip(names, p, strict=True)))
+                s = flutter_sensitivities(make(moved), density, [*names], v_max=v_max)
                 vf, vd = s.flutter_speed, s.divergence_speed
+                why = s.non_differentiable or next(
+                    (f"{n}: {s.undefined[n]}" for n in names if n in s.undefined), None
+                )
                 dvf = np.array([s.d_flutter_speed.get(n, 0.0) for n in names]) * scale
                 dvd = np.array([s.d_divergence_speed.get(n, 0.0) for n in names]) * scale
-            else:
-                vf, vd, dvf, dvd = _central(
-                    wing, names, p, scale, density, n_elements, wagner, v_max, count
-                )
+                if why is not None and vf is not None:
+                    how = f"central ({why})"
+            if how != "analytic":
+                vf, vd, dvf, dvd = _central(make, wing, names, p, scale, density, v_max, count)
             top = v_max if v_max is not None else np.inf
             cache[key] = (vf if vf is not None else top, vd if vd is not None else top, dvf, dvd)
             log.append(
@@ -152,19 +161,24 @@ def optimize_wing(
                     "variables": dict(zip(names, map(float, p), strict=True)),
                     "flutter_speed": vf,
                     "divergence_speed": vd,
+                    "gradients": how,
                 }
             )
         return cache[key]
 
+    # the objective's scale: its magnitude at the start (never its sign: a negative weight or
+    # value must not turn the minimization into a maximization)
+    norm = 1.0 if weights is None else float(abs(weights @ p0)) or float(abs(weights) @ abs(p0))
+
     def f(x):
         if weights is None:
             return -analyse(x)[0] / analyse(np.ones_like(x))[0]
-        return float(weights @ (x * scale)) / float(weights @ p0)
+        return float(weights @ (x * scale)) / (norm or 1.0)
 
     def df(x):
         if weights is None:
             return -analyse(x)[2] / analyse(np.ones_like(x))[0]
-        return weights * scale / float(weights @ p0)
+        return weights * scale / (norm or 1.0)
 
     cons = []
     for idx, bound in limits.values():
@@ -186,7 +200,7 @@ def optimize_wing(
     )
     best = dict(zip(names, map(float, sol.x * scale), strict=True))
     check = flutter_boundary(
-        AeroelasticModel(with_parameters(wing, best), n_elements, wagner), density, v_max=v_max
+        make(with_parameters(wing, best)), density, v_max=v_max
     )  # a fresh model and analysis
     values = {"flutter_speed": check.flutter_speed, "divergence_speed": check.divergence_speed}
     active, margins = [], {}
@@ -271,14 +285,13 @@ def _constraints(constraints: object) -> dict:
     return out
 
 
-def _central(wing, names, p, scale, density, n_elements, wagner, v_max, count):
-    """Speeds and their gradients by central differences (relative step 1e-5)."""
+def _central(make, wing, names, p, scale, density, v_max, count):
+    """Speeds and their gradients by central differences (relative step 1e-5); ``make``
+    builds the model of a wing."""
 
     def speeds(q):
         count[0] += 1
-        m = AeroelasticModel(
-            with_parameters(wing, dict(zip(names, q, strict=True))), n_elements, wagner
-        )
+        m = make(with_parameters(wing, dict(zip(names, q, strict=True))))
         r = flutter_boundary(m, density, v_max=v_max, rtol=1e-12)
         return r.flutter_speed, r.divergence_speed
 

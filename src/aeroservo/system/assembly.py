@@ -6,24 +6,23 @@ Everything here runs once per (wing, mesh); speeds and densities only scale the 
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import scipy.sparse as sp
 
-from ..aero.theodorsen import section_aero
+from ..aero.theodorsen import SectionAero, section_aero
 from ..structure.beam_element import field_shapes, gauss_rule, integrate, lag_shapes, point_shapes
 from ..structure.mesh import Mesh
 from ..structure.wing import Wing
 from .matrices import AeroMatrices, StripGroup
 
-__all__ = ["assemble", "element_properties", "structural_derivative", "STRUCTURAL_PARAMETERS"]
+__all__ = ["assemble", "element_properties", "section_coefficients"]
 
 
 def element_properties(wing: Wing, mesh: Mesh) -> dict[str, np.ndarray]:
     """Section properties per element (constant within an element by construction of the mesh).
 
-    Returns a dict of arrays of length n_elements: ``b, a, mass, s_alpha, inertia, EI, GJ`` of
+    Returns a dict of arrays of length n_elements: ``b, a, mass, x_alpha, s_alpha, inertia, EI,
+    GJ`` of
     the wing and ``c, s_beta, i_beta, GJ_f, k_delta`` of the flap (c = 1 and zeros where there
     is no control surface: a zero-chord flap, whose aerodynamic terms all vanish).
     """
@@ -32,6 +31,7 @@ def element_properties(wing: Wing, mesh: Mesh) -> dict[str, np.ndarray]:
         "b": np.array([s.semichord for s in segs]),
         "a": np.array([s.a for s in segs]),
         "mass": np.array([s.mass for s in segs]),
+        "x_alpha": np.array([s.x_alpha for s in segs]),
         "s_alpha": np.array([s.static_moment for s in segs]),
         "inertia": np.array([s.inertia for s in segs]),
         "EI": np.array([s.EI for s in segs]),
@@ -54,7 +54,33 @@ def element_properties(wing: Wing, mesh: Mesh) -> dict[str, np.ndarray]:
     return p
 
 
-def _scatter(
+def section_coefficients(p: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, SectionAero]:
+    """Section matrices on ``[w, phi, delta]`` per element from :func:`element_properties`.
+
+    Returns ``(ms, kd, kn, aero)``: structural mass (n_el, 3, 3) [kg/m, kg m/m, kg m],
+    stiffness of the strains ``[w'', phi', delta']`` [N m^2] and of the unknowns (hinge springs)
+    [N m/rad per m], and the Theodorsen coefficients. Flap terms vanish where there is no flap.
+    Complex properties give complex coefficients (complex-step derivatives).
+    """
+    b = p["b"]
+    n_el = b.shape[0]
+    dtype = np.result_type(*p.values(), float)
+    y_h = b * (p["c"] - p["a"])
+    ms = np.zeros((n_el, 3, 3), dtype)
+    ms[:, 0, 0] = p["mass"]
+    ms[:, 0, 1] = ms[:, 1, 0] = -p["mass"] * p["x_alpha"] * b  # S_alpha = m x_alpha b
+    ms[:, 0, 2] = ms[:, 2, 0] = -p["s_beta"]
+    ms[:, 1, 1] = p["inertia"]
+    ms[:, 1, 2] = ms[:, 2, 1] = p["i_beta"] + y_h * p["s_beta"]
+    ms[:, 2, 2] = p["i_beta"]
+    kd = np.zeros((n_el, 3, 3), dtype)
+    kd[:, 0, 0], kd[:, 1, 1], kd[:, 2, 2] = p["EI"], p["GJ"], p["GJ_f"]
+    kn = np.zeros((n_el, 3, 3), dtype)
+    kn[:, 2, 2] = p["k_delta"]
+    return ms, kd, kn, section_aero(b, p["a"], p["c"])
+
+
+def scatter_blocks(
     blocks: np.ndarray, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]
 ) -> sp.csr_matrix:
     """Sum element blocks (n_el, p, q) into a sparse matrix, dropping removed unknowns (-1)."""
@@ -85,21 +111,7 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     n_el = mesh.n_elements
     nz = lag_shapes(xi)[None, :, None, :].repeat(n_el, axis=0)  # (n_el, n_g, 1, 2)
 
-    # structural section matrices on [w, phi, delta]; flap terms vanish where there is no flap
-    y_h = p["b"] * (p["c"] - p["a"])
-    ms = np.zeros((n_el, 3, 3))
-    ms[:, 0, 0] = p["mass"]
-    ms[:, 0, 1] = ms[:, 1, 0] = -p["s_alpha"]
-    ms[:, 0, 2] = ms[:, 2, 0] = -p["s_beta"]
-    ms[:, 1, 1] = p["inertia"]
-    ms[:, 1, 2] = ms[:, 2, 1] = p["i_beta"] + y_h * p["s_beta"]
-    ms[:, 2, 2] = p["i_beta"]
-    kd = np.zeros((n_el, 3, 3))
-    kd[:, 0, 0], kd[:, 1, 1], kd[:, 2, 2] = p["EI"], p["GJ"], p["GJ_f"]
-    kn = np.zeros((n_el, 3, 3))
-    kn[:, 2, 2] = p["k_delta"]
-
-    aero = section_aero(p["b"], p["a"], p["c"])
+    ms, kd, kn, aero = section_coefficients(p)
 
     def elem(left, coef, right):
         return integrate(L, wts, left, coef[:, None], right)
@@ -107,14 +119,14 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     # unknowns in an extended numbering: the clamped root (w, theta, phi) get the last 3 indices,
     # so one scatter gives both the free matrices and the root-reaction rows
     n_q = mesh.n_dofs
-    edofs = _extended_dofs(mesh)
+    edofs = extended_dofs(mesh)
     n_x = n_q + 3
     n_n = mesh.n_nodes
     lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
 
     def split(blocks, rows, cols, shape):
         """Scatter, then split extended structural rows/columns into free and root parts."""
-        full = _scatter(blocks, rows, cols, shape)
+        full = scatter_blocks(blocks, rows, cols, shape)
         if cols is edofs:
             full = full[:, :n_q]
         if rows is edofs:
@@ -128,7 +140,7 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     parts, parts_r = {}, {}
     for i, name in enumerate(("bending", "torsion")):
         parts[name], parts_r[name] = qq(kd * _unit(i), D, D)
-    k_act = _actuator_stiffness(wing, mesh, n_q)
+    k_act = actuator_stiffness(wing, mesh, n_q)
     flap_all = qq(kd * _unit(2), D, D)[0] + qq(kn)[0] + k_act
     for k, cs in enumerate(wing.control_surfaces):
         mask = np.zeros(n_q)
@@ -146,14 +158,16 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
         sel = (p["b"] == b).astype(float)[:, None, None]
         pq, pq_r = qq(aero.Pq * sel)
         pd, pd_r = qq(aero.Pd * sel)
-        gw = _scatter(elem(N, aero.w[:, :, None] * sel, nz), edofs, lag_dofs, (n_x, n_n))
+        gw = scatter_blocks(elem(N, aero.w[:, :, None] * sel, nz), edofs, lag_dofs, (n_x, n_n))
         gw = np.asarray(gw.sum(axis=1)).ravel()  # lag shape functions sum to one
         groups.append(StripGroup(float(b), pq, pd, gw[:n_q]))
         groups_r.append(StripGroup(float(b), pq_r, pd_r, gw[n_q:]))
 
     # lag fields: term-independent base matrices on the nodes
-    Mz1 = _scatter(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
-    Lz1 = _scatter(elem(nz, (1.0 / p["b"])[:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n))
+    Mz1 = scatter_blocks(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
+    Lz1 = scatter_blocks(
+        elem(nz, (1.0 / p["b"])[:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n)
+    )
     E1 = split(elem(nz, aero.r_q[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
     F1 = split(elem(nz, aero.r_d[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
     W1, W1_r = split(elem(N, aero.w[:, :, None], nz), edofs, lag_dofs, (n_x, n_n))
@@ -196,7 +210,7 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     )
 
 
-def _extended_dofs(mesh: Mesh) -> np.ndarray:
+def extended_dofs(mesh: Mesh) -> np.ndarray:
     """Element unknowns with the clamped root's (w, theta, phi) numbered n_q, n_q+1, n_q+2, so
     one scatter gives the free matrices and the root rows."""
     n_q = mesh.n_dofs
@@ -211,7 +225,7 @@ def _unit(i: int) -> np.ndarray:
     return out
 
 
-def _actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
+def actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
     """Point springs k_act delta_D(x - x_a) acting on the flap rotation of their surface."""
     rows, cols, vals = [], [], []
     for k, cs in enumerate(wing.control_surfaces):
@@ -230,82 +244,3 @@ def _actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
                     cols.append(dofs[j])
                     vals.append(act.stiffness * nd[i] * nd[j])
     return sp.coo_matrix((vals, (rows, cols)), shape=(n_q, n_q)).tocsr()
-
-
-STRUCTURAL_PARAMETERS = {
-    "segment": ("mass", "x_alpha", "inertia", "EI", "GJ"),
-    "surface": ("static_moment", "inertia", "GJ", "hinge_stiffness"),
-    "actuator": ("stiffness",),
-}
-"""Parameters that enter only the structural matrices, by owner (wing-file keys)."""
-
-
-def structural_derivative(
-    wing: Wing, mesh: Mesh, owner: str, index: tuple[int, ...], key: str
-) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """Derivatives ``(dMs/dp, dKs/dp)`` of the structural matrices with respect to one
-    parameter, from the element integrals of the derivative of the section matrices.
-
-    Parameters
-    ----------
-    wing : Wing
-    mesh : Mesh
-    owner : {"segment", "surface", "actuator"}
-        What the parameter belongs to (:data:`STRUCTURAL_PARAMETERS`).
-    index : tuple of int
-        ``(i,)`` for ``segments[i]`` or ``control_surfaces[i]``, ``(k, j)`` for
-        ``control_surfaces[k].actuators[j]``.
-    key : str
-        The wing-file key (e.g. ``"EI"``).
-
-    Returns
-    -------
-    (dMs, dKs) : sparse (n_q, n_q)
-        Per unit of the parameter (the matrices are linear in every one of these parameters,
-        so the derivative is exact at any value).
-    """
-    if key not in STRUCTURAL_PARAMETERS.get(owner, ()):
-        raise ValueError(f"{owner} parameter {key!r}: not a structural parameter")
-    n_q = mesh.n_dofs
-    zero = sp.csr_matrix((n_q, n_q))
-    if owner == "actuator":
-        k, j = index
-        cs = wing.control_surfaces[k]
-        act = replace(cs.actuators[j], stiffness=1.0)
-        unit = replace(wing, control_surfaces=(replace(cs, actuators=(act,)),))
-        return zero, _actuator_stiffness(unit, mesh, n_q)
-    p = element_properties(wing, mesh)
-    on = (mesh.segment if owner == "segment" else mesh.surface) == index[0]
-    dm, dk, dn = (np.zeros((mesh.n_elements, 3, 3)) for _ in range(3))
-    if owner == "segment":
-        seg = wing.segments[index[0]]
-        if key == "mass":  # S_alpha = m x_alpha b moves with m
-            dm[:, 0, 0] = 1.0
-            dm[:, 0, 1] = dm[:, 1, 0] = -seg.x_alpha * seg.semichord
-        elif key == "x_alpha":
-            dm[:, 0, 1] = dm[:, 1, 0] = -seg.mass * seg.semichord
-        elif key == "inertia":
-            dm[:, 1, 1] = 1.0
-        elif key in ("EI", "GJ"):
-            dk[:, int(key == "GJ"), int(key == "GJ")] = 1.0
-    elif key == "static_moment":
-        dm[:, 0, 2] = dm[:, 2, 0] = -1.0
-        dm[:, 1, 2] = dm[:, 2, 1] = p["b"] * (p["c"] - p["a"])
-    elif key == "inertia":
-        dm[:, 1, 2] = dm[:, 2, 1] = dm[:, 2, 2] = 1.0
-    elif key == "GJ":
-        dk[:, 2, 2] = 1.0
-    elif key == "hinge_stiffness":
-        dn[:, 2, 2] = 1.0
-    on = on.astype(float)[:, None, None]
-    L = mesh.lengths
-    xi, wts = gauss_rule()
-    N, D, _ = field_shapes(L, xi)
-    edofs = _extended_dofs(mesh)  # the clamped root, dropped below
-    shape = (n_q + 3, n_q + 3)
-
-    def qq(coef, left, right):
-        blocks = integrate(L, wts, left, (coef * on)[:, None], right)
-        return _scatter(blocks, edofs, edofs, shape)[:n_q, :n_q].tocsr()
-
-    return qq(dm, N, N), qq(dk, D, D) + qq(dn, N, N)

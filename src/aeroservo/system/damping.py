@@ -25,7 +25,13 @@ import scipy.sparse as sp
 
 from ..errors import InputError, check_number, check_quantity
 
-__all__ = ["StructuralDamping", "damping_matrix", "NO_DAMPING"]
+__all__ = [
+    "StructuralDamping",
+    "damping_matrix",
+    "damping_derivatives",
+    "damping_parameters",
+    "NO_DAMPING",
+]
 
 KINDS = ("none", "modal", "rayleigh", "structural_g")
 
@@ -157,3 +163,95 @@ def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
     c = 2.0 * damping.mode_ratios(omega) * omega
     mp = M @ phi
     return sp.csr_matrix((mp * c) @ mp.T)
+
+
+GAP = 1e-6
+"""In-vacuo eigenvalues closer than this (relative) with different damping ratios: the modal
+damping matrix has no derivative (which mode gets which ratio is undecided)."""
+
+
+def damping_parameters(damping: StructuralDamping) -> dict[str, float]:
+    """The damping's own parameters by their file names (``damping.g``, ``damping.ratio`` or
+    ``damping.ratio[i]``, ``damping.alpha``, ``damping.beta``) and values; empty if undamped."""
+    if not damping.active:
+        return {}
+    if damping.kind == "modal":
+        r = damping.ratios
+        if len(r) == 1:
+            return {"damping.ratio": r[0]}
+        return {f"damping.ratio[{i}]": v for i, v in enumerate(r)}
+    if damping.kind == "rayleigh":
+        return {"damping.alpha": damping.alpha, "damping.beta": damping.beta}
+    return {"damping.g": damping.g}
+
+
+def damping_derivatives(damping: StructuralDamping, Ms, Ks):
+    """Derivatives of the damping matrix, as two functions of one eigen-decomposition.
+
+    Returns
+    -------
+    (d_structure, d_own)
+        ``d_structure(dMs, dKs)`` gives ``dCs/dp`` for a parameter moving the structural matrices
+        by ``dMs, dKs`` (Rayleigh: ``alpha dMs + beta dKs``; modal and structural g: the
+        eigenvector derivatives of ``Cs = Ms Phi diag(2 zeta_j omega_j) Phi^T Ms``, Nelson's
+        closed form through the divided differences of ``f(lambda) = 2 zeta sqrt(lambda)``;
+        raises ValueError when two modes of different ratios coincide, see :data:`GAP`).
+        ``d_own(name)`` gives ``dCs/dp`` for a name of :func:`damping_parameters`.
+    """
+    M = Ms.toarray() if sp.issparse(Ms) else np.asarray(Ms, dtype=float)
+    K = Ks.toarray() if sp.issparse(Ks) else np.asarray(Ks, dtype=float)
+    if damping.kind == "rayleigh":
+
+        def d_structure(dMs, dKs):
+            return sp.csr_matrix(damping.alpha * dMs + damping.beta * dKs)
+
+        def d_own(name):
+            return sp.csr_matrix(M if name == "damping.alpha" else K)
+
+        return d_structure, d_own
+    lam, phi = sla.eigh(K, M)
+    lam = np.clip(lam, 0.0, None)
+    s = np.sqrt(lam)
+    zeta = damping.mode_ratios(s)
+    f = 2.0 * zeta * s
+    mp = M @ phi
+    li, lj = lam[:, None], lam[None, :]
+    si, sj = s[:, None], s[None, :]
+    zi, zj = zeta[:, None], zeta[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gap = lj - li
+        d1 = (zj * sj - zi * si) * 2.0 / gap
+        d2 = (zj * sj * lj - zi * si * li) * 2.0 / gap
+        same = zi == zj  # the closed forms of the divided differences of 2 zeta sqrt(lambda)
+        d1 = np.where(same, 2.0 * zi / (si + sj), d1)
+        d2 = np.where(same, 2.0 * zi * (li + si * sj + lj) / (si + sj), d2)
+    clash = ~same & (np.abs(gap) <= GAP * np.maximum(li, lj))
+    np.fill_diagonal(d1, zeta / s)
+    np.fill_diagonal(d2, 3.0 * zeta * s)
+
+    def d_structure(dMs, dKs):
+        if clash.any():
+            i, j = np.argwhere(clash)[0]
+            raise ValueError(
+                f"in-vacuo modes {i + 1} and {j + 1} have the same frequency and different "
+                "damping ratios: the modal damping matrix has no derivative"
+            )
+        dm = dMs.toarray() if sp.issparse(dMs) else np.asarray(dMs)
+        dk = dKs.toarray() if sp.issparse(dKs) else np.asarray(dKs)
+        g = (phi.T @ dk @ phi) * d1 - (phi.T @ dm @ phi) * d2
+        outer = (dm @ phi * f) @ mp.T
+        return sp.csr_matrix(outer + outer.T + mp @ g @ mp.T)
+
+    def d_own(name):
+        if name == "damping.g":
+            weight = s  # C = g Ms Phi diag(omega) Phi^T Ms
+        else:
+            ratios = np.asarray(damping.ratios)
+            i = 0 if name == "damping.ratio" else int(name[len("damping.ratio[") : -1])
+            idx = np.arange(s.size)
+            last = ratios.size - 1
+            on = (idx == i) | ((i == last) & (idx > last)) if ratios.size > 1 else idx >= 0
+            weight = 2.0 * s * on
+        return sp.csr_matrix((mp * weight) @ mp.T)
+
+    return d_structure, d_own

@@ -33,7 +33,15 @@ from ..aero.indicial import IndicialSet
 from ..errors import InputError, check_number
 from .matrices import AeroMatrices
 
-__all__ = ["FirstOrderSystem", "first_order", "check_mach", "MACH_LIMIT", "MACH_APPROXIMATE"]
+__all__ = [
+    "FirstOrderSystem",
+    "first_order",
+    "pencil_blocks",
+    "lag_factors",
+    "check_mach",
+    "MACH_LIMIT",
+    "MACH_APPROXIMATE",
+]
 
 
 @dataclass
@@ -185,9 +193,86 @@ def check_mach(mach: object, field: str = "mach") -> float:
 
 
 def compressibility_factors(mach: float) -> tuple[float, float]:
-    """``(1 / beta, beta^2)`` of the Prandtl-Glauert correction at a Mach number < 1."""
-    beta2 = 1.0 - float(mach) ** 2
+    """``(1 / beta, beta^2)`` of the Prandtl-Glauert correction at a Mach number < 1 (a complex
+    Mach number, a complex step, gives complex factors)."""
+    m = mach if isinstance(mach, complex) else float(mach)
+    beta2 = 1.0 - m**2
     return 1.0 / np.sqrt(beta2), beta2
+
+
+def lag_factors(wagner: IndicialSet, mach: float) -> tuple[float, np.ndarray, np.ndarray]:
+    """Scalars of the circulatory terms at a Mach number: ``c (1 - sum A)`` (the factor of
+    ``Pq``, ``Pd`` in ``Ka``, ``Ca``), the lag rates ``b_i beta^2`` and the row
+    ``c A_i b_i beta^2`` of ``Dz``."""
+    A = np.asarray(wagner.A)
+    c, beta2 = compressibility_factors(mach)
+    bt = np.asarray(wagner.b) * beta2
+    return c * (1.0 - A.sum()), bt, c * A * bt
+
+
+def pencil_blocks(
+    am: AeroMatrices,
+    wagner: IndicialSet,
+    density: float,
+    mach: float = 0.0,
+    *,
+    constant: bool = True,
+) -> dict[str, sp.csr_matrix]:
+    """The pencil ``E, A0, A1, A2`` of the module notes and its lag blocks.
+
+    Every block is linear in the matrices of ``am``, so the same function gives the pencil's
+    derivative from the matrices' derivatives, with ``constant=False`` (the identity blocks of
+    ``qdot = v`` left out).
+
+    Returns
+    -------
+    dict
+        ``E, A0, A1, A2`` (sparse, n x n) and ``M, Ka, Dz, Lam, Ez, Fz, Mz`` of the notes.
+    """
+    rho = density
+    n_q, n_n = am.n_q, am.n_nodes
+    scale, bt, dz_row = lag_factors(wagner, mach)
+    T = bt.size
+    one_col = sp.csr_matrix(np.ones((T, 1)))
+
+    M = (am.Ms + rho * am.Mnc).tocsr()
+    Ca = am.Cnc - scale * am.Pd
+    Ka = am.Knc - scale * am.Pq
+    Mz = sp.kron(am.Mz1, sp.eye(T)).tocsr()
+    Lam = sp.kron(am.Lz1, sp.diags(bt)).tocsr()
+    Ez = sp.kron(am.E1, one_col).tocsr()
+    Fz = sp.kron(am.F1, one_col).tocsr()
+    Dz = sp.kron(am.W1, sp.csr_matrix(dz_row[None, :])).tocsr()
+    n_z = n_n * T
+
+    I = sp.eye(n_q) if constant else sp.csr_matrix((n_q, n_q))
+    Zqq = None
+    Cs = -am.Cs if am.Cs is not None else None
+    A0 = sp.bmat([[Zqq, I, None], [-am.Ks, Cs, None], [None, Fz, sp.csr_matrix((n_z, n_z))]])
+    A1 = sp.bmat(
+        [[sp.csr_matrix((n_q, n_q)), None, None], [None, -rho * Ca, None], [Ez, None, -Lam]]
+    )
+    A2 = sp.bmat(
+        [
+            [sp.csr_matrix((n_q, n_q)), None, None],
+            [-rho * Ka, sp.csr_matrix((n_q, n_q)), rho * Dz],
+            [None, None, sp.csr_matrix((n_z, n_z))],
+        ]
+    )
+    E = sp.block_diag([I, M, Mz]).tocsr()
+    return {
+        "E": E,
+        "A0": A0.tocsr(),
+        "A1": A1.tocsr(),
+        "A2": A2.tocsr(),
+        "M": M,
+        "Ka": Ka,
+        "Dz": Dz,
+        "Lam": Lam,
+        "Ez": Ez,
+        "Fz": Fz,
+        "Mz": Mz,
+    }
 
 
 def first_order(
@@ -217,45 +302,14 @@ def first_order(
     FirstOrderSystem
     """
     rho = float(density)
-    n_q, n_n = am.n_q, am.n_nodes
-    A = np.asarray(wagner.A)
-    bt = np.asarray(wagner.b)
-    T = A.size
-    one_col = sp.csr_matrix(np.ones((T, 1)))
-    c, beta2 = compressibility_factors(mach)
-    scale = c * (1.0 - A.sum())
-    bt = bt * beta2
-
-    M = (am.Ms + rho * am.Mnc).tocsr()
-    Ca = am.Cnc - scale * am.Pd
-    Ka = am.Knc - scale * am.Pq
-    Mz = sp.kron(am.Mz1, sp.eye(T)).tocsr()
-    Lam = sp.kron(am.Lz1, sp.diags(bt)).tocsr()
-    Ez = sp.kron(am.E1, one_col).tocsr()
-    Fz = sp.kron(am.F1, one_col).tocsr()
-    Dz = sp.kron(am.W1, sp.csr_matrix((c * A * bt)[None, :])).tocsr()
-    n_z = n_n * T
-
-    I = sp.eye(n_q)
-    Zqq = None
-    Cs = -am.Cs if am.Cs is not None else None
-    A0 = sp.bmat([[Zqq, I, None], [-am.Ks, Cs, None], [None, Fz, sp.csr_matrix((n_z, n_z))]])
-    A1 = sp.bmat(
-        [[sp.csr_matrix((n_q, n_q)), None, None], [None, -rho * Ca, None], [Ez, None, -Lam]]
-    )
-    A2 = sp.bmat(
-        [
-            [sp.csr_matrix((n_q, n_q)), None, None],
-            [-rho * Ka, sp.csr_matrix((n_q, n_q)), rho * Dz],
-            [None, None, sp.csr_matrix((n_z, n_z))],
-        ]
-    )
-    E = sp.block_diag([I, M, Mz]).tocsr()
+    blocks = pencil_blocks(am, wagner, rho, mach)
+    Ka, Dz, Lam, Ez = (blocks[k] for k in ("Ka", "Dz", "Lam", "Ez"))
+    T = np.asarray(wagner.A).size
 
     lam_dense = Lam.toarray()
     K_static = Ka.toarray() - Dz.toarray() @ np.linalg.solve(lam_dense, Ez.toarray())
-    mz_dense = Mz.toarray()
-    lag_at_rest = sp.csr_matrix(np.linalg.solve(mz_dense, Fz.toarray()))
+    mz_dense = blocks["Mz"].toarray()
+    lag_at_rest = sp.csr_matrix(np.linalg.solve(mz_dense, blocks["Fz"].toarray()))
 
     labels = (
         tuple(am.dof_labels)
@@ -263,15 +317,15 @@ def first_order(
         + tuple(f"z{t + 1}_{node}" for node in am.lag_labels for t in range(T))
     )
     return FirstOrderSystem(
-        E=E,
-        A0=A0.tocsr(),
-        A1=A1.tocsr(),
-        A2=A2.tocsr(),
-        n_q=n_q,
+        E=blocks["E"],
+        A0=blocks["A0"],
+        A1=blocks["A1"],
+        A2=blocks["A2"],
+        n_q=am.n_q,
         state_labels=labels,
         density=rho,
         Ks=am.Ks.tocsr(),
-        M=M,
+        M=blocks["M"],
         K_static=K_static,
         lag_at_rest=lag_at_rest,
         semichord=float(semichord),
