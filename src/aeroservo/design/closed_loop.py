@@ -305,16 +305,22 @@ def closed_loop_boundary(
     n_eval = [0]
 
     cached = getattr(plant_at, "sampled_plant", None) if sampled else None
+    known: dict[float, tuple[float, complex]] = {}  # the root finder starts at grid points
 
     def evaluate(v: float) -> tuple[float, complex]:
+        v = float(v)
+        if v in known:
+            return known[v]
         n_eval[0] += 1
         ctrl = _controller_at(controller, v)
         if cached is not None:  # a ControlLoop: its sampled plants are reused across designs
             law = linear_law(ctrl, plant_at.n_plant_states)
             sp = cached(v, ctrl.dt, list(ctrl.controls), list(law.sensors))
-            return _measure(loop_matrix(sp, law, delay), ctrl.dt)
-        A, dt = closed_loop_matrix(at(v), ctrl, sampled=sampled, delay=delay)
-        return _measure(A, dt)
+            known[v] = _measure(loop_matrix(sp, law, delay), ctrl.dt)
+        else:
+            A, dt = closed_loop_matrix(at(v), ctrl, sampled=sampled, delay=delay)
+            known[v] = _measure(A, dt)
+        return known[v]
 
     V = np.linspace(v_min, v_max, n_grid)
     g = np.empty(n_grid)
