@@ -199,7 +199,8 @@ def flutter_boundary(
     if modal.basis is None:
         exact[:] = True  # the modal model is the full model
     if modal.basis is not None:  # at rest: the full model's modes (apparent mass included)
-        lam[0] = system.modes_at_rest(lam.shape[1])[0]
+        m = lam.shape[1]
+        lam[0] = lam_full0 if lam_full0.size == m else system.modes_at_rest(m)[0]
         exact[0] = True
     labels = _labels(src, modal, br)
     info = {

@@ -71,6 +71,7 @@ class Verifier:
         n, m = branches.eigenvalues.shape
         self.values = np.full((n, m), np.nan + 0j)
         self._vec: dict[tuple[int, int], np.ndarray] = {}
+        self._followed: dict[tuple[int, int, float], complex] = {}
 
     @property
     def exact(self) -> np.ndarray:
@@ -104,7 +105,18 @@ class Verifier:
         return self._vec[(k, j)]
 
     def follow(self, j: int, k: int, v: float) -> complex:
-        """Full-model eigenvalue of branch j at speed v, continued from grid point k."""
+        """Full-model eigenvalue of branch j at speed v, continued from grid point k (each
+        speed once: a root finder starts at grid points and ends where it last evaluated)."""
+        V = self.br.speeds
+        for g in (k, k + 1):  # a grid point already verified on the full model
+            if g < V.size and v == V[g] and np.isfinite(self.values[g, j]):
+                return complex(self.values[g, j])
+        key = (j, k, float(v))
+        if key not in self._followed:
+            self._followed[key] = self._follow(j, k, v)
+        return self._followed[key]
+
+    def _follow(self, j: int, k: int, v: float) -> complex:
         V = self.br.speeds
         lam_k = self.at(k, j)
         if k + 1 < V.size and np.isfinite(self.values[k + 1, j]):
