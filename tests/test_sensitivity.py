@@ -91,11 +91,25 @@ def central(model, density, name, value, v_max):
     return d("flutter_speed"), d("flutter_frequency"), dd
 
 
+def two_surfaces() -> aes.Wing:
+    """Goland with an inboard flap (no actuator) and the aileron, whose actuators are moved off
+    the mesh nodes: an actuator of the second surface (the review found its stiffness
+    derivative put on the first surface's flap)."""
+    from dataclasses import replace
+
+    w0 = goland_aileron()
+    ail = w0.control_surfaces[0]
+    inner = replace(ail, name="inner", start=0.5, end=2.5, actuators=())
+    acts = tuple(replace(a, station=a.station + 0.2) for a in ail.actuators)
+    return replace(w0, control_surfaces=(inner, replace(ail, actuators=acts)))
+
+
 def _named():
     hale = HALE["inputs"]
     return [
         ("goland", aes.AeroelasticModel(goland()), 1.225, None),
         ("goland_aileron", aes.AeroelasticModel(goland_aileron()), 1.225, None),
+        ("two_surfaces", aes.AeroelasticModel(two_surfaces()), 1.225, None),
         ("hale", aes.AeroelasticModel(hale_wing()), hale["density_kg_m3"], None),
         ("hale_aileron", aes.AeroelasticModel(hale_wing(True)), hale["density_kg_m3"], None),
     ]
@@ -165,12 +179,16 @@ LINEAR = ("mass", "x_alpha", "inertia", "EI", "GJ", "static_moment", "hinge_stif
 FIELDS = ("Ms", "Ks", "Mnc", "Cnc", "Knc", "Pq", "Pd", "Lz1", "E1", "F1", "W1")
 
 
-@pytest.mark.parametrize("name", list(parameter_values(goland_aileron())))
-def test_matrix_derivatives_against_differences_of_the_assembly(name):
+@pytest.mark.parametrize(
+    "wing_name,name",
+    [("aileron", n) for n in parameter_values(goland_aileron())]
+    + [("two", n) for n in parameter_values(two_surfaces()) if "control_surfaces[1]" in n],
+)
+def test_matrix_derivatives_against_differences_of_the_assembly(wing_name, name):
     """Every matrix derivative (complex step of the section coefficients, element integrals)
     against differences of two full assemblies: the slope for the parameters the matrices are
     linear in, a central difference (relative step 1e-5, truncation ~1e-10) for the others."""
-    wing = off_node_aileron()
+    wing = off_node_aileron() if wing_name == "aileron" else two_surfaces()
     model = aes.AeroelasticModel(wing)
     owner, idx, key, value = parameter_values(wing)[name]
     d = matrix_derivative(wing, model.mesh, owner, idx, key)
@@ -425,6 +443,9 @@ def test_normalized_and_dict():
         ({"parameters": ["segments[3].GJ"]}, "'segments[3].GJ' is not a parameter"),
         ({"parameters": "density"}, "expected a list"),
         ({"density": None}, "density = None"),
+        ({"density": None, "atmosphere": isa(3000.0), "mach": 0.5}, "mach with an atmosphere"),
+        ({"atmosphere": isa(3000.0)}, "density and atmosphere"),
+        ({"compressibility": "prandtl-glauert"}, "needs the speed of sound"),
     ],
 )
 def test_bad_arguments(kwargs, fragment):
@@ -496,3 +517,54 @@ def test_closed_loop_case_sensitivities():
     assert "finite differences" in a.to_dict()["method"]
     with pytest.raises(InputError, match="'hinge_stiffness' is not a parameter"):
         case_sensitivities(study, case, ["hinge_stiffness"])
+
+
+@pytest.mark.parametrize("compressibility", [None, "prandtl-glauert"])
+def test_altitude_at_a_layer_top_has_two_one_sided_derivatives(compressibility):
+    """At 11 km (tropopause) the lapse rate changes: no altitude derivative, but the one-sided
+    ones below and above, each equal to the one-sided difference of the engine's analyses."""
+    from aeroservo.stability.matched import flutter_at
+
+    model = aes.AeroelasticModel(goland_aileron())
+    s = flutter_sensitivities(
+        model,
+        atmosphere=isa(11000.0),
+        compressibility=compressibility,
+        rtol=RTOL,
+        parameters=["altitude", "density"],
+    )
+    assert "altitude" not in s.d_flutter_speed and "density" in s.d_flutter_speed
+    why = s.undefined["altitude"]
+    assert "layer" in why and "below" in why and "above" in why
+    v = {
+        h: flutter_at(model, isa(h), compressibility=compressibility, rtol=RTOL).flutter_speed
+        for h in (10999.0, 11000.0, 11001.0)
+    }
+    got = [float(t.split()[0]) for t in why.split("dV_f/dp = ")[1].split(";")[0].split(", ")]
+    for g, ref in zip(got, (v[11000.0] - v[10999.0], v[11001.0] - v[11000.0]), strict=True):
+        assert g == pytest.approx(ref, rel=1e-3)  # one-sided differences: O(h) truncation
+    assert got[1] > 1.1 * got[0]
+
+
+def test_actuator_at_a_surface_end_is_one_sided():
+    """A station on its surface's end can only move inwards: one inward derivative, named."""
+    wing = goland_aileron()
+    name = "control_surfaces[0].actuators[1].station"
+    wing = with_parameters(wing, {name: wing.control_surfaces[0].end})
+    s = flutter_sensitivities(aes.AeroelasticModel(wing), 1.225, [name])
+    assert "end of its control surface" in s.undefined[name] and "inward" in s.undefined[name]
+    assert "outboard" not in s.undefined[name]
+
+
+def test_damped_modes_at_rest_on_an_exact_eigenvalue():
+    """Rayleigh damping on a corpus wing where the Rayleigh-quotient iteration lands on the
+    eigenvalue exactly (a singular solve, found by review): the pair is returned."""
+    case = {c.name: c for c in corpus()}["two_flaps_04"]
+    a = case.model.wing.segments[0].a
+    wing = with_parameters(case.model.wing, {"segments[0].a": a - 1e-5 * abs(a)})
+    damping = StructuralDamping.rayleigh(0.200002, 1e-4)
+    model = aes.AeroelasticModel(wing, n_elements=case.model.n_elements, damping=damping)
+    lam, X = model.system(case.density).modes_at_rest(6)
+    assert np.all(np.isfinite(lam)) and np.all(lam.real < 0)
+    s = flutter_sensitivities(model, case.density, ["density"], v_max=case.v_max)
+    assert s.flutter_speed is None or "density" in s.d_flutter_speed

@@ -24,6 +24,7 @@ __all__ = [
     "isa",
     "isa_ft",
     "isa_slopes",
+    "on_layer_boundary",
     "FT",
     "KNOT",
     "RHO0",
@@ -135,12 +136,13 @@ def isa(altitude: float, *, geometric: bool = False) -> Atmosphere:
     return Atmosphere(h, T, p, rho, math.sqrt(GAMMA * R_AIR * T))
 
 
-def isa_slopes(atmosphere: Atmosphere) -> tuple[float, float]:
+def isa_slopes(atmosphere: Atmosphere, side: int = -1) -> tuple[float, float]:
     """Derivatives of density and speed of sound with geopotential altitude.
 
     From the hydrostatic equation and the ideal gas, ``drho/dH = -rho (g0 / (R T) + T' / T)``
-    and ``da/dH = a T' / (2 T)``, with the lapse rate ``T'`` of the layer (at a layer's top the
-    layer below, as in :func:`isa`; there the slopes have a kink).
+    and ``da/dH = a T' / (2 T)``, with the lapse rate ``T'`` of the layer. At a layer's top
+    (:func:`on_layer_boundary`) the slopes have a kink: ``side`` -1 gives those of the layer
+    below, +1 of the layer above.
 
     Returns
     -------
@@ -148,9 +150,18 @@ def isa_slopes(atmosphere: Atmosphere) -> tuple[float, float]:
         [kg/m^3 per m], [1/s].
     """
     h, T = atmosphere.altitude, atmosphere.temperature
-    lapse = next(lp for base, lp in reversed(_LAYERS) if h > base or base == 0.0)
+    above = side > 0 and on_layer_boundary(h)
+    lapse = next(
+        lp for base, lp in reversed(_LAYERS) if (h >= base if above else h > base) or base == 0.0
+    )
     drho = -atmosphere.density * (G0 / (R_AIR * T) + lapse / T)
     return drho, atmosphere.speed_of_sound * lapse / (2.0 * T)
+
+
+def on_layer_boundary(altitude: float) -> bool:
+    """Whether a geopotential altitude [m] is a boundary between two layers of different
+    lapse rates (11, 20 and 32 km), where density and speed of sound have kinks."""
+    return any(abs(altitude - base) <= 1e-9 * base for base, _ in _LAYERS[1:])
 
 
 def isa_ft(altitude_ft: float, *, geometric: bool = False) -> Atmosphere:

@@ -201,7 +201,9 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
             C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
             F, G = C.real, C.imag
             k = k + rho * (-V * V * F * pq + w * V * G * pd)
-            c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
+            # a frequency driven to zero (flagged below) gives an infinite, harmless term
+            with np.errstate(divide="ignore", invalid="ignore"):
+                c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
         w = np.sqrt(np.clip(k / m, 0.0, None))
     bad: dict[int, str] = {}
     for i, v in enumerate(V[:, 0]):  # the first speed at which each mode fails

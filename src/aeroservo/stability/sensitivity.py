@@ -207,6 +207,8 @@ def flutter_sensitivities(
         why = terms.add(name, table.get(name))
         if why:
             out.undefined[name] = why
+    if "altitude" in terms.kinks and "altitude" in names:
+        out.undefined["altitude"] = terms.kinks["altitude"][0]
     if r.flutter_speed is not None:
         out.non_differentiable = _tie(r)
         if out.non_differentiable is None:
@@ -230,6 +232,11 @@ def _boundary(model, density, atmosphere, compressibility, rtol, kw) -> FlutterR
         return flutter_boundary(model, density, rtol=rtol, **kw)
     if density is not None:
         raise InputError("density and atmosphere: give one of them")
+    if "mach" in kw:
+        raise InputError(
+            "mach with an atmosphere: the Mach number is the flight's (give compressibility="
+            "'prandtl-glauert' to match it), or give a density and a fixed mach"
+        )
     from .matched import flutter_at
 
     return flutter_at(model, atmosphere, compressibility=compressibility, rtol=rtol, **kw)

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..aero.atmosphere import isa, isa_slopes
+from ..aero.atmosphere import isa, isa_slopes, on_layer_boundary
 from ..system.damping import damping_derivatives
 from ..system.derivatives import matrix_derivative, station_on_node, zero_derivative
 from ..system.first_order import pencil_blocks
@@ -36,14 +36,24 @@ class Terms:
         self.rho, self.mach = result.density, result.mach
         self.am = model.matrices
         self.items: dict[str, list] = {}  # name -> matrix derivatives (two for a kink)
-        self.kinks: dict[str, str] = {}
+        self.kinks: dict[str, tuple[str, tuple[str, ...]]] = {}  # name -> (why, sides)
         self.damping = (
             damping_derivatives(model.damping, self.am.Ms, self.am.Ks)
             if model.damping.active
             else None
         )
         self.a = result.speed_of_sound
-        self.slopes = isa_slopes(isa(result.altitude)) if result.altitude is not None else None
+        self.slopes = []  # (drho/dH, da/dH) of the layer, or below and above a layer's top
+        if result.altitude is not None:
+            atm = isa(result.altitude)
+            self.slopes = [isa_slopes(atm, -1)]
+            if on_layer_boundary(result.altitude):
+                self.slopes.append(isa_slopes(atm, 1))
+                self.kinks["altitude"] = (
+                    "at the top of an atmosphere layer (the lapse rate changes): density and "
+                    "speed of sound have kinks",
+                    ("below", "above"),
+                )
 
     # ---- parameters -------------------------------------------------------------------------
     def add(self, name: str, entry) -> str | None:
@@ -58,9 +68,17 @@ class Terms:
             return None
         owner, index, key, _ = entry
         sides = [1]
-        if owner == "actuator" and key == "station" and station_on_node(m.wing, m.mesh, *index):
+        where = station_on_node(m.wing, m.mesh, *index) if key == "station" else None
+        if where == "node":
             sides = [-1, 1]
-            self.kinks[name] = "on a mesh node: the discretized model has a kink there"
+            why = "on a mesh node: the discretized model has a kink there"
+            self.kinks[name] = (why, ("inboard", "outboard"))
+        elif where == "edge":  # the station may only move into its surface
+            cs = m.wing.control_surfaces[index[0]]
+            x = cs.actuators[index[1]].station
+            sides = [1 if abs(x - cs.start) < abs(x - cs.end) else -1]
+            why = "at an end of its control surface (a bound of the station): one-sided"
+            self.kinks[name] = (why, ("inward",))
         mats = []
         for side in sides:
             dam = matrix_derivative(m.wing, m.mesh, owner, index, key, side=side)
@@ -114,8 +132,10 @@ class Terms:
                     dl_drho = form(self._aero_only(), 1.0)
                 d = [dl_drho]
                 if name == "altitude":
-                    drho, da = self.slopes
-                    d = [dl_drho * drho + (dl_dm * (-vf * da / self.a**2) if self.matched else 0)]
+                    d = [
+                        dl_drho * drho + (dl_dm * (-vf * da / self.a**2) if self.matched else 0)
+                        for drho, da in self.slopes
+                    ]
             elif name == "mach":
                 d = [dl_dm]
             else:
@@ -156,10 +176,11 @@ class Terms:
             if name == "density":
                 g = [vd * vd * static]
             elif name == "altitude":
-                drho, da = self.slopes
-                g = [drho * vd * vd * static]
-                if self.matched:
-                    g[0] += rho * vd * vd * dk_dm * (-vd * da / self.a**2)
+                g = [
+                    drho * vd * vd * static
+                    + (rho * vd * vd * dk_dm * (-vd * da / self.a**2) if self.matched else 0.0)
+                    for drho, da in self.slopes
+                ]
             elif name == "mach":
                 g = [rho * vd * vd * dk_dm]
             else:
@@ -175,9 +196,9 @@ class Terms:
                 out.d_divergence_speed[name] = float(dv[0])
 
     def _one_sided(self, out, name: str, what: str, dv: list) -> None:
-        text = f"{what}/dp = {dv[0]:.6g} inboard, {dv[1]:.6g} outboard"
-        prev = out.undefined.get(name, self.kinks[name])
-        out.undefined[name] = f"{prev}; {text}"
+        why, sides = self.kinks[name]
+        text = f"{what}/dp = " + ", ".join(f"{v:.6g} {s}" for v, s in zip(dv, sides, strict=True))
+        out.undefined[name] = f"{out.undefined.get(name, why)}; {text}"
 
 
 def _static(am, wagner, rho: float, mach) -> np.ndarray:

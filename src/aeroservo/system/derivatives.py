@@ -89,12 +89,14 @@ def matrix_derivative(
     zero_q, zero_n = sp.csr_matrix((n_q, n_q)), sp.csr_matrix((n_n, n_n))
     if owner == "actuator":
         dk = _station_derivative(wing, mesh, *index, side) if key == "station" else None
-        if dk is None:
+        if dk is None:  # the wing with this actuator alone, of unit stiffness
             k, j = index
-            cs = wing.control_surfaces[k]
-            act = replace(cs.actuators[j], stiffness=1.0)
-            unit = replace(wing, control_surfaces=(replace(cs, actuators=(act,)),))
-            dk = actuator_stiffness(unit, mesh, n_q)
+            act = replace(wing.control_surfaces[k].actuators[j], stiffness=1.0)
+            surfaces = tuple(
+                replace(c, actuators=(act,) if i == k else ())
+                for i, c in enumerate(wing.control_surfaces)
+            )
+            dk = actuator_stiffness(replace(wing, control_surfaces=surfaces), mesh, n_q)
         return _matrices(mesh, {"Ks": dk}, zero_q, zero_n)
 
     p = element_properties(wing, mesh)
@@ -172,11 +174,15 @@ def _matrices(mesh: Mesh, parts: dict, zero_q, zero_n) -> AeroMatrices:
     )
 
 
-def station_on_node(wing: Wing, mesh: Mesh, k: int, j: int) -> bool:
-    """Whether actuator ``j`` of control surface ``k`` sits on a mesh node (there the
-    discretized model's stiffness has a kink in the station)."""
-    x = wing.control_surfaces[k].actuators[j].station
-    return bool(np.any(np.abs(mesh.nodes - x) <= 1e-12 * wing.span))
+def station_on_node(wing: Wing, mesh: Mesh, k: int, j: int) -> str | None:
+    """Where actuator ``j`` of control surface ``k`` sits on a mesh node: ``"edge"`` (an end
+    of its surface: the station's bound, one inward derivative), ``"node"`` (an interior node:
+    the discretized model's stiffness has a kink there) or None."""
+    cs = wing.control_surfaces[k]
+    x, tol = cs.actuators[j].station, 1e-12 * wing.span
+    if abs(x - cs.start) <= tol or abs(x - cs.end) <= tol:
+        return "edge"
+    return "node" if np.any(np.abs(mesh.nodes - x) <= tol) else None
 
 
 def _station_derivative(wing: Wing, mesh: Mesh, k: int, j: int, side: int) -> sp.csr_matrix:

@@ -157,7 +157,12 @@ def _damped_pair(K, C, M, lam: complex, q: np.ndarray) -> tuple[complex, np.ndar
         lam = new
         if done:
             break
-        y = np.linalg.solve(lam * lam * M + lam * C + K, (2 * lam * M + C) @ q)
+        T = lam * lam * M + lam * C + K
+        try:
+            y = np.linalg.solve(T, (2 * lam * M + C) @ q)
+        except np.linalg.LinAlgError:  # lam is an eigenvalue to rounding: its null vector
+            q = sla.svd(T)[2][-1].conj()
+            break
         q = y / np.linalg.norm(y)
     return lam, q
 
