@@ -27,7 +27,7 @@ from .hinf import hinf
 from .lqg import lqg
 from .lqr import Bryson, lqr
 from .mpc import mpc
-from .plant import OpenLoop, SampledPlant, state_map, with_sensor_filters
+from .plant import OpenLoop, SampledPlant, filter_arrays, state_map, with_sensor_filters
 from .schedule import GainSchedule, schedule
 from .spec import ControllerSpec
 
@@ -132,7 +132,13 @@ class ControlLoop:
         if hit is not None:
             self._sampled.move_to_end(key)
             return hit
-        sp = SampledPlant.from_statespace(self.plant(speed), dt, controls, (), outputs)
+        # the matrices of plant(speed) without its python-control models (the same numbers)
+        arrays = self.plant_builder.matrices(speed, balanced=True)
+        if self.sensor_filter is not None:
+            rows = [self.plant_builder.output_labels.index(s) for s in self.filtered]
+            arrays = filter_arrays(*arrays, rows, self.sensor_filter, self.filter_order)
+        labels = (self.plant_builder.input_labels, self.plant_builder.output_labels)
+        sp = SampledPlant.from_arrays(arrays, labels, dt, controls, (), outputs)
         self._sampled[key] = sp
         while len(self._sampled) > SAMPLED_CACHE:
             self._sampled.popitem(last=False)

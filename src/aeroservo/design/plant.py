@@ -34,6 +34,7 @@ __all__ = [
     "select",
     "state_map",
     "with_sensor_filters",
+    "filter_arrays",
 ]
 
 
@@ -141,8 +142,22 @@ class SampledPlant:
         if outputs is None:
             outputs = list(sys.output_labels)
         outputs = check_names("outputs", outputs, empty=True)
-        A, Bu, C, Du = select(sys, controls, outputs)
-        _, Bd, _, Dd = select(sys, disturbances, outputs)
+        arrays = tuple(np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
+        labels = (sys.input_labels, sys.output_labels)
+        return cls.from_arrays(arrays, labels, dt, controls, disturbances, outputs)
+
+    @classmethod
+    def from_arrays(
+        cls, arrays: tuple, labels: tuple, dt: float, controls, disturbances, outputs
+    ) -> SampledPlant:
+        """As :meth:`from_statespace`, from ``(A, B, C, D)`` and ``(input_labels,
+        output_labels)`` (checked names, no python-control model)."""
+        dt = check_number("sample period", dt, unit="s", lo=0.0, lo_open=True)
+        ii, jj = (_index(labels[0], names, "input") for names in (controls, disturbances))
+        oo = _index(labels[1], outputs, "output")
+        A, B, C, D = arrays
+        Bu, Bd, C = B[:, ii], B[:, jj], C[oo]
+        Du, Dd = D[np.ix_(oo, ii)], D[np.ix_(oo, jj)]
         Phi, G = zoh(A, np.hstack([Bu, Bd]), dt)
         m = len(controls)
         return cls(
@@ -301,32 +316,12 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
     import control
 
     check_continuous("sys", sys)
-    fc = check_number("cutoff", cutoff, unit="Hz", lo=0.0, lo_open=True, hi=MAX_CUTOFF)
-    is_int = isinstance(order, (int, np.integer)) and not isinstance(order, bool)
-    if not is_int or order not in (1, 2, 3, 4):
-        raise InputError(f"order = {describe(order)}: allowed values are 1, 2, 3, 4")
-    order = int(order)
-    fa, fb, fc_ = _butterworth(order, fc)
-    A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
-    n, m = B.shape
     rows = _index(sys.output_labels, sensors, "sensor")
-    k = fa.shape[0]
-    nf = k * len(rows)
-    Aa = np.zeros((n + nf, n + nf))
-    Ba = np.zeros((n + nf, m))
-    Ca = np.hstack([C, np.zeros((C.shape[0], nf))])
-    Da = D.copy()
-    Aa[:n, :n] = A
-    Ba[:n] = B
+    arrays = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
+    Aa, Ba, Ca, Da = filter_arrays(*arrays, rows, cutoff, order)
+    k = (Aa.shape[0] - sys.nstates) // max(len(rows), 1)
     states = list(sys.state_labels)
-    for j, r in enumerate(rows):
-        s = slice(n + j * k, n + (j + 1) * k)
-        Aa[s, s] = fa
-        Aa[s, :n] = fb @ C[r : r + 1]
-        Ba[s] = fb @ D[r : r + 1]
-        Ca[r] = 0.0
-        Ca[r, s] = fc_[0]
-        Da[r] = 0.0
+    for r in rows:
         states += [f"{sys.output_labels[r]}_filter{i + 1}" for i in range(k)]
     out = control.ss(
         Aa,
@@ -341,3 +336,31 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
         if hasattr(sys, attr):
             setattr(out, attr, getattr(sys, attr))
     return out
+
+
+def filter_arrays(A, B, C, D, rows: Sequence[int], cutoff: float, order: int = 2) -> tuple:
+    """The matrices of :func:`with_sensor_filters` (outputs ``rows`` filtered), without the
+    python-control model around them."""
+    fc = check_number("cutoff", cutoff, unit="Hz", lo=0.0, lo_open=True, hi=MAX_CUTOFF)
+    is_int = isinstance(order, (int, np.integer)) and not isinstance(order, bool)
+    if not is_int or order not in (1, 2, 3, 4):
+        raise InputError(f"order = {describe(order)}: allowed values are 1, 2, 3, 4")
+    fa, fb, fc_ = _butterworth(int(order), fc)
+    n, m = B.shape
+    k = fa.shape[0]
+    nf = k * len(rows)
+    Aa = np.zeros((n + nf, n + nf))
+    Ba = np.zeros((n + nf, m))
+    Ca = np.hstack([C, np.zeros((C.shape[0], nf))])
+    Da = D.copy()
+    Aa[:n, :n] = A
+    Ba[:n] = B
+    for j, r in enumerate(rows):
+        s = slice(n + j * k, n + (j + 1) * k)
+        Aa[s, s] = fa
+        Aa[s, :n] = fb @ C[r : r + 1]
+        Ba[s] = fb @ D[r : r + 1]
+        Ca[r] = 0.0
+        Ca[r, s] = fc_[0]
+        Da[r] = 0.0
+    return Aa, Ba, Ca, Da

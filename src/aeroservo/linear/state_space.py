@@ -297,10 +297,14 @@ class StateSpaceBuilder:
         self.units = {d.name: d.unit for d in self.inputs} | output_units(self.outputs)
         self._scaling: np.ndarray | None = None
 
-    def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(A, B, C, D)`` at ``speed`` [m/s]."""
+    def matrices(self, speed: float, *, balanced: bool = False) -> tuple[np.ndarray, ...]:
+        """``(A, B, C, D)`` at ``speed`` [m/s] (``balanced``: the states of :meth:`at`)."""
         v = check_number("speed", speed, unit="m/s", lo=0.0, hi=MAX_SPEED)
-        return self._A(v), self._B(v), self._C(v), self._D(v)
+        A, B, C, D = self._A(v), self._B(v), self._C(v), self._D(v)
+        if balanced:
+            s = self.state_scaling
+            A, B, C = A * (1.0 / s)[:, None] * s[None, :], B / s[:, None], C * s[None, :]
+        return A, B, C, D
 
     @property
     def state_scaling(self) -> np.ndarray:
@@ -342,12 +346,8 @@ class StateSpaceBuilder:
 
         if not isinstance(balanced, (bool, np.bool_)):
             raise InputError(f"balanced = {describe(balanced)}: expected True or False")
-        A, B, C, D = self.matrices(speed)
+        A, B, C, D = self.matrices(speed, balanced=balanced)
         s = self.state_scaling if balanced else np.ones(A.shape[0])
-        if balanced:
-            A = A * (1.0 / s)[:, None] * s[None, :]
-            B = B / s[:, None]
-            C = C * s[None, :]
         sys = control.StateSpace(
             A,
             B,

@@ -130,8 +130,8 @@ def sweep_branches(
     w_all = [np.concatenate([lams[0], np.conj(lams[0])])]
     while V < v_max * (1 - 1e-12):
         nxt = next(s for s in stops if s > V * (1 + 1e-12))
-        # a checkpoint within half a step beyond the step is reached in this step (no sliver)
-        V1 = nxt if nxt - V - 1.5 * h < 1e-9 * v_max else V + h
+        # a checkpoint within 10 % beyond the step is reached in this step (no sliver step)
+        V1 = nxt if nxt - V - 1.1 * h < 1e-9 * v_max else V + h
         try:
             w, X = np.linalg.eig(a0 + V1 * a1 + (V1 * V1) * a2)
             w, X = w.astype(complex, copy=False), X.astype(complex, copy=False)

@@ -106,11 +106,7 @@ class Verifier:
 
     def follow(self, j: int, k: int, v: float) -> complex:
         """Full-model eigenvalue of branch j at speed v, continued from grid point k (each
-        speed once: a root finder starts at grid points and ends where it last evaluated)."""
-        V = self.br.speeds
-        for g in (k, k + 1):  # a grid point already verified on the full model
-            if g < V.size and v == V[g] and np.isfinite(self.values[g, j]):
-                return complex(self.values[g, j])
+        ``(j, k, v)`` once: the crossing is re-read where the root finder ended)."""
         key = (j, k, float(v))
         if key not in self._followed:
             self._followed[key] = self._follow(j, k, v)
