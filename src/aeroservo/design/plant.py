@@ -319,7 +319,7 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
     rows = _index(sys.output_labels, sensors, "sensor")
     arrays = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
     Aa, Ba, Ca, Da = filter_arrays(*arrays, rows, cutoff, order)
-    k = (Aa.shape[0] - sys.nstates) // max(len(rows), 1)
+    k = int(order)  # filter states per sensor (validated by filter_arrays)
     states = list(sys.state_labels)
     for r in rows:
         states += [f"{sys.output_labels[r]}_filter{i + 1}" for i in range(k)]
