@@ -32,56 +32,84 @@ SERIES_LIMIT = 13.0
 _EULER_GAMMA = 0.5772156649015329
 
 
+def _powers(z: np.ndarray, n: int) -> np.ndarray:
+    """``z[i]^m`` for ``m = 0 .. n - 1`` (rows: the points), by repeated multiplication."""
+    out = np.empty((z.size, n))
+    out[:, 0] = 1.0
+    if n > 1:
+        out[:, 1:] = z[:, None]
+        np.cumprod(out[:, 1:], axis=1, out=out[:, 1:])
+    return out
+
+
+def _series_coefficients(n_terms: int) -> np.ndarray:
+    """Coefficients of the four power series in ``q = -(x/2)^2`` of :func:`_hankel_ratio_series`
+    (rows: J0, J1 / (x/2), S0, S1 / (x/2)), for ``m = 0 .. n_terms - 1``."""
+    out = np.zeros((4, n_terms))
+    t, harmonic = 1.0, 0.0  # 1 / m!^2 and H_m
+    for m in range(n_terms):
+        if m:
+            t /= m * m
+            harmonic += 1.0 / m
+        u = t / (m + 1)  # 1 / (m! (m+1)!)
+        out[:, m] = (t, u, -harmonic * t, (2 * harmonic + 1.0 / (m + 1) - 2 * _EULER_GAMMA) * u)
+    return out
+
+
+_SERIES = _series_coefficients(200)
+
+
 def _hankel_ratio_series(x: np.ndarray) -> np.ndarray:
-    """H1(2)(x) / H0(2)(x) from the power series of J0, J1, Y0, Y1 (A&S 9.1.10-11), x > 0."""
+    """H1(2)(x) / H0(2)(x) from the power series of J0, J1, Y0, Y1 (A&S 9.1.10-11), x > 0.
+
+    ``J0 = sum q^m / m!^2``, ``J1 = (x/2) sum q^m / (m! (m+1)!)`` with ``q = -(x/2)^2``, and the
+    sums ``S0 = -sum H_m q^m / m!^2``, ``S1 = (x/2) sum (2 H_m + 1/(m+1) - 2 gamma) q^m /
+    (m! (m+1)!)`` of Y0 and Y1, all four as one product of the powers of q with the coefficients.
+    """
     half = float(np.max(x)) / 2
     n_terms, t = 1, 1.0  # terms until (x/2)^2m / m!^2 is below 1e-17 past its peak
     while n_terms < 200 and (n_terms <= half or t > 1e-17):
         t *= half * half / (n_terms * n_terms)
         n_terms += 1
-    q = -((x / 2) ** 2)
-    t = np.ones_like(x)  # (-x^2/4)^m / m!^2
-    j0, j1 = np.zeros_like(x), np.zeros_like(x)
-    s0 = np.zeros_like(x)  # sum (-1)^(m+1) H_m (x/2)^2m / m!^2
-    s1 = np.zeros_like(x)  # sum (-1)^m (psi(m+1) + psi(m+2)) (x/2)^(2m+1) / (m! (m+1)!)
-    harmonic = 0.0
-    for m in range(n_terms):
-        if m:
-            t = t * (q / (m * m))
-            harmonic += 1.0 / m
-        u = t * (x / (2 * (m + 1)))  # (-1)^m (x/2)^(2m+1) / (m! (m+1)!)
-        j0 += t
-        j1 += u
-        s0 -= harmonic * t
-        s1 += (2 * harmonic + 1.0 / (m + 1) - 2 * _EULER_GAMMA) * u
+    acc = _powers(-((x / 2) ** 2), n_terms) @ _SERIES[:, :n_terms].T
+    j0, s0 = acc[:, 0], acc[:, 2]
+    j1, s1 = (x / 2) * acc[:, 1], (x / 2) * acc[:, 3]
     log = np.log(x / 2)
     y0 = (2 / np.pi) * ((log + _EULER_GAMMA) * j0 + s0)
     y1 = (2 / np.pi) * log * j1 - 2 / (np.pi * x) - s1 / np.pi
     return (j1 - 1j * y1) / (j0 - 1j * y0)
 
 
+def _asymptotic_coefficients(n_terms: int) -> np.ndarray:
+    """``(-i)^k a_k(nu)`` of the Hankel expansions (A&S 9.2.7-8), rows nu = 0 and nu = 1."""
+    out = np.zeros((2, n_terms), dtype=complex)
+    for i, mu in enumerate((0.0, 4.0)):  # 4 nu^2
+        a = 1.0 + 0j
+        out[i, 0] = a
+        for k in range(1, n_terms):
+            a = a * (-1j) * (mu - (2 * k - 1) ** 2) / (8 * k)
+            out[i, k] = a
+    return out
+
+
+_ASYMPTOTIC = _asymptotic_coefficients(60)
+_ASYMPTOTIC_ABS = np.abs(_ASYMPTOTIC)
+
+
 def _hankel_ratio_asymptotic(x: np.ndarray) -> np.ndarray:
     """H1(2)(x) / H0(2)(x) = i S1 / S0 from the Hankel expansions (A&S 9.2.7-8), x large:
-    S_nu = sum_k (-i)^k a_k(nu) / x^k, summed while the terms of the smallest x decrease."""
+    S_nu = sum_k (-i)^k a_k(nu) / x^k, summed while the terms of the smallest x decrease
+    (both sums as one product of the powers of 1/x with the coefficients)."""
     x_min = float(np.min(x))
-    inv = 1.0 / x
-    sums = []
-    for mu in (0.0, 4.0):  # 4 nu^2
-        coef, a = [1.0 + 0j], 1.0 + 0j
-        for k in range(1, 60):
-            nxt = a * (-1j) * (mu - (2 * k - 1) ** 2) / (8 * k)
-            if (
-                abs(nxt) / x_min**k >= abs(a) / x_min ** (k - 1)
-                or abs(a) / x_min ** (k - 1) < 1e-17
-            ):
-                break
-            a = nxt
-            coef.append(a)
-        total = np.full(x.shape, coef[-1])
-        for c in coef[-2::-1]:  # Horner in 1/x
-            total = total * inv + c
-        sums.append(total)
-    return 1j * sums[1] / sums[0]
+    table = np.zeros_like(_ASYMPTOTIC)
+    for i in range(2):
+        terms = _ASYMPTOTIC_ABS[i] / x_min ** np.arange(60)
+        stop = (terms[1:] >= terms[:-1]) | (terms[:-1] < 1e-17)  # term k is not added
+        n = 1 + (int(np.argmax(stop)) if stop.any() else 59)
+        table[i, :n] = _ASYMPTOTIC[i, :n]
+    n = int(np.flatnonzero(table.any(axis=0))[-1]) + 1
+    total = _powers(1.0 / x, n) @ table[:, :n].T
+    return 1j * total[:, 1] / total[:, 0]
 
 
 def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
@@ -101,7 +129,7 @@ def theodorsen_function(k: np.ndarray | float) -> np.ndarray | complex:
         C(k) = F(k) + i G(k).
     """
     k_arr = np.asarray(k, dtype=float)
-    if np.any(k_arr < 0) or not np.all(np.isfinite(k_arr)):
+    if not np.all((k_arr >= 0) & (k_arr < np.inf)):  # NaN fails both
         raise ValueError(f"k = {k!r}: reduced frequency must be finite and >= 0")
     out = np.ones(k_arr.shape, dtype=complex)
     for sel, ratio in (

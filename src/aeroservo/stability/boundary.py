@@ -29,7 +29,6 @@ from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
-import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..errors import RANGES, InputError, check_int, check_number
@@ -140,7 +139,7 @@ def flutter_boundary(
     rtol = check_number("rtol", rtol, lo=1e-14, hi=1e-2)
     rho, mach = system.density, system.mach
     warnings = list(getattr(getattr(src, "mesh", None), "warnings", ()))
-    v_div = divergence_speeds(system)
+    v_div = divergence_speeds(system, src)
     if src is None:
         lam_full0, _ = system.modes_at_rest(system.n_q if n_modes is None else n_min)
     else:
@@ -194,7 +193,7 @@ def flutter_boundary(
         _verify_all(ver)
     crossings += _divergence(br, v_div, top)
     crossings.sort(key=lambda c: c.speed)
-    lam = np.column_stack([ver.best(j) for j in range(br.eigenvalues.shape[1])])
+    lam = ver.best()
     exact = ver.exact.copy()
     if modal.basis is None:
         exact[:] = True  # the modal model is the full model
@@ -275,7 +274,7 @@ def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progres
         method = "dense eig of the full model"
 
         def reference(v: float) -> np.ndarray:
-            return sla.eigvals(full.state_matrix(v), overwrite_a=True, check_finite=False)
+            return np.linalg.eigvals(full.state_matrix(v)).astype(complex, copy=False)
 
     else:
         n_big = min(2 * m, full.n_q)
@@ -283,7 +282,7 @@ def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progres
         method = f"modal model of {n_big} modes; branches in the band verified on the full model"
 
         def reference(v: float) -> np.ndarray:
-            return sla.eigvals(big.state_matrix(v))
+            return np.linalg.eigvals(big.state_matrix(v)).astype(complex, copy=False)
 
         for k in idx:
             for j in np.flatnonzero(

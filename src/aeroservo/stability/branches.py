@@ -71,14 +71,21 @@ def _predict(speeds: list, lams: list, v: float) -> np.ndarray:
     (Lagrange polynomial: constant, linear, then quadratic)."""
     n = min(len(speeds), 3)
     xs, ys = speeds[-n:], lams[-n:]
-    out = np.zeros_like(ys[-1])
+    out = None
     for i in range(n):
         weight = 1.0
         for j in range(n):
             if j != i:
                 weight *= (v - xs[j]) / (xs[i] - xs[j])
-        out = out + weight * ys[i]
+        term = weight * ys[i]
+        out = term if out is None else out + term
     return out
+
+
+def _scale(lam: np.ndarray) -> np.ndarray:
+    """Per-branch scale of eigenvalue distances: the modulus, at least 1e-3 of the largest."""
+    mod = np.abs(lam)
+    return np.maximum(mod, 1e-3 * np.max(mod) + 1e-12)
 
 
 def sweep_branches(
@@ -128,6 +135,7 @@ def sweep_branches(
     n_amb = 0
     V = 0.0
     w_all = [np.concatenate([lams[0], np.conj(lams[0])])]
+    scale, osc_prev = _scale(lams[0]), is_complex(lams[0])  # of the last accepted speed
     while V < v_max * (1 - 1e-12):
         nxt = next(s for s in stops if s > V * (1 + 1e-12))
         # a checkpoint within 10 % beyond the step is reached in this step (no sliver step)
@@ -146,7 +154,6 @@ def sweep_branches(
         cand = np.flatnonzero(w.imag >= 0)
         prev = lams[-1]
         pred = _predict(speeds, lams, V1)
-        scale = np.maximum(np.abs(prev), 1e-3 * np.max(np.abs(prev)) + 1e-12)
         cost = np.abs(w[cand][None, :] - pred[:, None]) / scale[:, None]
         rows, cols = min_cost_assignment(cost)
         pick = np.empty(prev.size, dtype=int)
@@ -154,10 +161,11 @@ def sweep_branches(
         new_l = w[pick]
         new_x = X[:, pick]
         new_x = new_x / np.sqrt(np.einsum("ij,ij->j", new_x.conj(), new_x).real)
-        osc = is_complex(new_l) & is_complex(prev)
-        change = np.abs(new_l - prev) / scale
-        miss = np.abs(new_l - pred) / scale
-        slow = bool((change <= 2 * max_rel_change).all())
+        osc_new = is_complex(new_l)
+        osc = osc_new & osc_prev
+        change = float((np.abs(new_l - prev) / scale).max())
+        miss = float((np.abs(new_l - pred) / scale).max())
+        slow = change <= 2 * max_rel_change
         ok = slow
         if ok and osc.any():
             d1 = cost[rows, cols]
@@ -166,7 +174,7 @@ def sweep_branches(
             d2 = c2.min(axis=1) if c2.shape[1] > 1 else np.full(rows.size, np.inf)
             clear = d1 <= 0.5 * d2 + 1e-12
             corr = np.abs(np.einsum("ij,ij->j", vecs[-1].conj(), new_x)) ** 2  # unit vectors
-            ok = bool(clear[osc[rows]].all() and (corr[osc] >= mac_min).all())
+            ok = bool(clear[osc[rows]].all()) and bool((corr[osc] >= mac_min).all())
         if not ok and (h > h_ambiguous or (not slow and h > h_min)):
             h = 0.5 * min(h, V1 - V)
             continue
@@ -176,14 +184,15 @@ def sweep_branches(
         vecs.append(new_x)
         w_all.append(w)
         V = V1
+        scale, osc_prev = _scale(new_l), osc_new
         if progress is not None:
             progress(V)
         # the next step scales the one just taken (a step cut short to reach a checkpoint
         # does not shrink the next); the predictor's miss grows as h^order
         order = 3.0 if len(speeds) >= 4 else 2.0
         factor = min(
-            0.9 * max_rel_change / max(float(change.max()), 1e-12),
-            0.9 * (pred_tol / max(float(miss.max()), 1e-12)) ** (1.0 / order),
+            0.9 * max_rel_change / max(change, 1e-12),
+            0.9 * (pred_tol / max(miss, 1e-12)) ** (1.0 / order),
         )
         h = min(max(h, V1 - speeds[-2]) * min(max(factor, 0.5), 2.0), h_max)
     return _done(speeds, lams, vecs, w_all, n_amb, None)

@@ -134,14 +134,16 @@ def certify(
         modal = modal[modal.imag >= 0]
         known = np.concatenate([values[k][exact[k]], modal])
         lam_all = reference(v)
-        for j, lam_b in enumerate(br.eigenvalues[k]):
-            if exact[k, j]:
-                d = abs(values[k, j] - lam_b) / abs(lam_b)
-            elif is_complex(np.array([lam_b]))[0] and abs(lam_b) <= band_top:
-                d = float(np.min(np.abs(lam_all - lam_b))) / abs(lam_b)
-            else:
-                continue
-            err[j] = np.fmax(err[j], d)
+        lam_b = br.eigenvalues[k]
+        mod = np.abs(lam_b)
+        with np.errstate(divide="ignore", invalid="ignore"):  # lam_b = 0 only where skipped
+            nearest = np.min(np.abs(lam_all[:, None] - lam_b[None, :]), axis=0) / mod
+            d = np.where(
+                exact[k],
+                np.abs(values[k] - lam_b) / mod,
+                np.where(is_complex(lam_b) & (mod <= band_top), nearest, np.nan),
+            )
+        err = np.fmax(err, d)  # NaN (not checked) keeps the previous value
         lam_f = lam_all[_relevant(lam_all, band_top)]
         cert.n_checked += lam_f.size
         if lam_f.size == 0:
@@ -178,20 +180,13 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
     from .modal import _all_modes
 
     freqs, phi, _labels = _all_modes(model)
-    rest = phi[:, n_kept:]
-    if rest.shape[1] == 0:
+    if phi.shape[1] <= n_kept:
         return []
-    am = model.matrices
     w0 = 2 * np.pi * freqs[n_kept:]
-
-    def diag(a):
-        return np.einsum("ij,ij->j", rest, np.asarray(a @ rest))
-
+    mnc, knc, cnc, groups = _modal_aero(model, n_kept)
     rho = density
     cf, beta2 = compressibility_factors(mach)
-    m = 1.0 + rho * diag(am.Mnc)
-    knc, cnc = diag(am.Knc), diag(am.Cnc)
-    groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
+    m = 1.0 + rho * mnc
     V = np.linspace(v_max / 16, v_max, 16)[:, None]  # speeds down, modes across
     w = np.broadcast_to(w0, (V.size, w0.size))
     for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
@@ -205,12 +200,36 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
             with np.errstate(divide="ignore", invalid="ignore"):
                 c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
         w = np.sqrt(np.clip(k / m, 0.0, None))
-    bad: dict[int, str] = {}
-    for i, v in enumerate(V[:, 0]):  # the first speed at which each mode fails
-        for j in np.flatnonzero(c[i] <= 0):
-            bad.setdefault(int(j), f"negative aerodynamic damping at {v:.4g} m/s")
-        for j in np.flatnonzero(w[i] <= KEEP_FREQUENCY * w0):
-            bad.setdefault(
-                int(j), f"frequency down to {w[i, j] / (2 * np.pi):.4g} Hz at {v:.4g} m/s"
-            )
-    return [(float(freqs[n_kept + j]), why) for j, why in sorted(bad.items())]
+    damped_out = c <= 0
+    failed = damped_out | (w <= KEEP_FREQUENCY * w0)
+    out = []
+    for j in np.flatnonzero(failed.any(axis=0)):  # at the first speed at which it fails
+        i = int(np.argmax(failed[:, j]))
+        v = V[i, 0]
+        why = (
+            f"negative aerodynamic damping at {v:.4g} m/s"
+            if damped_out[i, j]
+            else f"frequency down to {w[i, j] / (2 * np.pi):.4g} Hz at {v:.4g} m/s"
+        )
+        out.append((float(freqs[n_kept + j]), why))
+    return out
+
+
+def _modal_aero(model, n_kept: int) -> tuple:
+    """Modal (diagonal) aerodynamic terms of the in-vacuo modes above the first ``n_kept``:
+    apparent mass, non-circulatory stiffness and damping, and per circulatory group its
+    semichord with the downwash terms (cached on the model: they do not depend on density)."""
+    from .modal import _all_modes
+
+    cache = model.__dict__.setdefault("_modal_cache", {})
+    key = ("truncated", n_kept)
+    if key not in cache:
+        rest = _all_modes(model)[1][:, n_kept:]
+        am = model.matrices
+
+        def diag(a):
+            return np.einsum("ij,ij->j", rest, np.asarray(a @ rest))
+
+        groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
+        cache[key] = (diag(am.Mnc), diag(am.Knc), diag(am.Cnc), groups)
+    return cache[key]

@@ -122,9 +122,13 @@ class Verifier:
             guess = lam_k
         return self.tracker.follow(v, guess, self.vector(k, j), float(V[k]))[0]
 
-    def best(self, j: int) -> np.ndarray:
-        """Branch j on the grid: full-model values where computed, modal ones elsewhere."""
-        return np.where(self.exact[:, j], self.values[:, j], self.br.eigenvalues[:, j])
+    def best(self, j: int | None = None) -> np.ndarray:
+        """Branch j (default: every branch, as columns) on the grid: full-model values where
+        computed, modal ones elsewhere."""
+        if j is None:
+            return np.where(self.exact, self.values, self.br.eigenvalues)
+        values = self.values[:, j]
+        return np.where(np.isfinite(values), values, self.br.eigenvalues[:, j])
 
 
 def sign_changes(

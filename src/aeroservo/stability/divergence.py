@@ -40,6 +40,12 @@ def static_speeds(Ks: np.ndarray, K_static: np.ndarray, density: float) -> np.nd
     if K_static.shape != Ks.shape:
         raise InputError(f"K_static: shape {K_static.shape}, expected {Ks.shape} like Ks")
     density = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+    return _speeds(_divergence_eigenvalues(Ks, K_static), density)
+
+
+def _divergence_eigenvalues(Ks: np.ndarray, K_static: np.ndarray) -> np.ndarray:
+    """The real positive eigenvalues ``mu`` of ``-Ks^-1 K_static`` above round-off [m s^2/kg]:
+    ``rho V^2 = 1 / mu`` at divergence (independent of the density)."""
     w2, phi = sla.eigh(Ks)  # Ks = phi diag(w2) phi^T, w2 > 0
     scale = phi / np.sqrt(np.clip(w2, np.finfo(float).tiny, None))
     S = -(scale.T @ K_static @ scale)
@@ -49,13 +55,31 @@ def static_speeds(Ks: np.ndarray, K_static: np.ndarray, density: float) -> np.nd
         return np.empty(0)
     big = float(np.max(np.abs(mu)))
     keep = (mu.real > ROUND_OFF * big) & (np.abs(mu.imag) <= 1e-8 * np.abs(mu))
-    return np.sort(1.0 / np.sqrt(density * mu.real[keep]))
+    return mu.real[keep]
 
 
-def divergence_speeds(system: FirstOrderSystem) -> np.ndarray:
-    """Every static divergence speed [m/s] of a first-order system, increasing."""
+def _speeds(mu: np.ndarray, density: float) -> np.ndarray:
+    return np.sort(1.0 / np.sqrt(density * mu))
+
+
+def divergence_speeds(system: FirstOrderSystem, model: object = None) -> np.ndarray:
+    """Every static divergence speed [m/s] of a first-order system, increasing.
+
+    Parameters
+    ----------
+    system : FirstOrderSystem
+    model : AeroelasticModel, optional
+        The model ``system`` comes from: the eigenvalues, which do not depend on the density,
+        are then solved once per Mach number and kept on the model.
+    """
     _check_system(system)
-    return static_speeds(system.Ks.toarray(), system.K_static, system.density)
+    if model is None:
+        return static_speeds(system.Ks.toarray(), system.K_static, system.density)
+    cache = model.__dict__.setdefault("_modal_cache", {})
+    key = ("divergence", system.mach)
+    if key not in cache:
+        cache[key] = _divergence_eigenvalues(system.Ks.toarray(), system.K_static)
+    return _speeds(cache[key], system.density)
 
 
 def divergence_speed(system: FirstOrderSystem) -> float | None:

@@ -51,9 +51,10 @@ class EigenTracker:
         self.n_q = system.n_q
         self.dense = system.n_states <= DENSE_LIMIT
         if self.dense:
-            # complex copies: mixed real-complex products would convert at every iteration
-            self._E = system.E.toarray().astype(complex)
-            self._A = tuple(a.toarray().astype(complex) for a in (system.A0, system.A1, system.A2))
+            # a complex E: a mixed real-complex product would convert E at every iteration
+            e, *self._A = system.dense_pencil()
+            self._E = e.astype(complex)
+            self._E_nz = np.nonzero(e)  # the shift A - sigma E changes only these entries
         else:
             self._E = system.E.tocsc()
             self._A = tuple(a.tocsc() for a in (system.A0, system.A1, system.A2))
@@ -62,21 +63,30 @@ class EigenTracker:
     # -- linear algebra -------------------------------------------------------------------
     def _pencil(self, speed: float):
         a0, a1, a2 = self._A
-        return a0 + speed * a1 + (speed * speed) * a2
+        out = a0 + speed * a1 + (speed * speed) * a2
+        return out.astype(complex) if self.dense else out
+
+    def _shifted(self, A, sigma: complex):
+        """``A - sigma E`` (dense: a copy of A with E's entries shifted)."""
+        if not self.dense:
+            return A - sigma * self._E
+        out = A.copy()
+        out[self._E_nz] -= sigma * self._E[self._E_nz]
+        return out
 
     def _factor(self, A, sigma: complex) -> Callable[[np.ndarray], np.ndarray]:
         """LU of ``A - sigma E``: LAPACK for dense systems, SuperLU for sparse ones."""
         self.n_factorizations += 1
         if self.dense:
-            lu, piv, info = zgetrf(A - sigma * self._E, overwrite_a=True)
+            lu, piv, info = zgetrf(self._shifted(A, sigma), overwrite_a=True)
             if info > 0:  # the shift is an exact eigenvalue: nudge it
                 lu, piv, info = zgetrf(
-                    A - (sigma * (1 + 1e-12) + 1e-12) * self._E, overwrite_a=True
+                    self._shifted(A, sigma * (1 + 1e-12) + 1e-12), overwrite_a=True
                 )
             return lambda b: zgetrs(lu, piv, b)[0]
         from scipy.sparse.linalg import splu
 
-        return splu((A - sigma * self._E).astype(complex).tocsc()).solve
+        return splu(self._shifted(A, sigma).astype(complex).tocsc()).solve
 
     def correct(
         self, speed: float, lam0: complex, x0: np.ndarray

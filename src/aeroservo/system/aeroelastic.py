@@ -144,11 +144,15 @@ class AeroelasticModel:
         shapes : ndarray (n_q, n_modes)
         """
         parts = self.matrices.stiffness_parts
+        shapes = np.asarray(shapes)
+        energies = {
+            name: np.real(np.einsum("ij,ij->j", shapes.conj(), np.asarray(k @ shapes)))
+            for name, k in parts.items()
+        }
         counts: dict[str, int] = {}
         labels = []
         for j in range(shapes.shape[1]):
-            q = shapes[:, j]
-            energy = {name: float(np.real(np.vdot(q, k @ q))) for name, k in parts.items()}
+            energy = {name: float(e[j]) for name, e in energies.items()}
             kind = max(energy, key=energy.get)
             counts[kind] = counts.get(kind, 0) + 1
             labels.append(f"{_ordinal(counts[kind])} {kind}")

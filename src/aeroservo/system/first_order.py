@@ -89,6 +89,7 @@ class FirstOrderSystem:
     mach: float = 0.0
     Cs: sp.csr_matrix | None = None
     _dense: tuple | None = field(default=None, repr=False)
+    _pencil_dense: tuple | None = field(default=None, repr=False)
 
     @property
     def n_states(self) -> int:
@@ -109,6 +110,12 @@ class FirstOrderSystem:
             einv = _block_inverse(self.E, n_q)
             self._dense = tuple(einv @ a.toarray() for a in (self.A0, self.A1, self.A2))
         return self._dense
+
+    def dense_pencil(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Dense ``(E, A0, A1, A2)``, computed once and cached."""
+        if self._pencil_dense is None:
+            self._pencil_dense = tuple(a.toarray() for a in (self.E, self.A0, self.A1, self.A2))
+        return self._pencil_dense
 
     def state_matrix(self, speed: float) -> np.ndarray:
         """Dense state matrix ``A(V) = E^-1 (A0 + V A1 + V^2 A2)`` [1/s]."""
