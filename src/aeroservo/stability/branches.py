@@ -6,7 +6,10 @@ axis and splits into two real roots (an exceptional point), a double real root o
 overdamped mode needs no special treatment. Branches (one per mode at rest) are then matched
 between consecutive speeds by an optimal assignment on the distance to a linear prediction; a
 step is accepted when every complex branch is matched unambiguously, moved by less than a
-fraction of its modulus and correlates with its previous eigenvector, else it is halved.
+fraction of its modulus and correlates with its previous eigenvector, else it is halved. A branch
+far from the imaginary axis (damping ratio beyond :data:`FAR_ZETA` at both ends of the step) may
+move twice as far: a crossing hidden between two grid points would need it to travel at least
+its distance to the axis.
 Where a branch is real (overdamped) its identity is that of the nearest real root and no
 ambiguity test applies: flutter crossings happen off the real axis, real roots cross zero only
 at the static divergence speeds (:mod:`aeroservo.stability.divergence`).
@@ -26,6 +29,11 @@ __all__ = ["Branches", "sweep_branches", "is_complex"]
 
 COMPLEX = 1e-7
 """A branch is complex (oscillatory) where ``Im(lambda) > COMPLEX |lambda|``."""
+
+
+FAR_ZETA = 0.25
+"""Branches whose ``|damping ratio|`` exceeds this at both ends of a step count half their change
+in the step control (:func:`sweep_branches`)."""
 
 
 def is_complex(lam: np.ndarray) -> np.ndarray:
@@ -88,6 +96,11 @@ def _scale(lam: np.ndarray) -> np.ndarray:
     return np.maximum(mod, 1e-3 * np.max(mod) + 1e-12)
 
 
+def _far(lam: np.ndarray) -> np.ndarray:
+    """Whether eigenvalues are far from the imaginary axis (``|Re| > FAR_ZETA |lambda|``)."""
+    return np.abs(lam.real) > FAR_ZETA * np.abs(lam)
+
+
 def sweep_branches(
     system: FirstOrderSystem,
     lam0: np.ndarray,
@@ -116,7 +129,8 @@ def sweep_branches(
         Called with each accepted speed.
     max_rel_change : float
         Largest change of a branch eigenvalue per step relative to its modulus (bounds how far
-        a hump can hide between grid points).
+        a hump can hide between grid points); twice that for a branch far from the axis
+        (:data:`FAR_ZETA`).
     pred_tol : float
         Target miss of the linear predictor relative to the modulus (fine steps where a branch
         bends).
@@ -135,7 +149,8 @@ def sweep_branches(
     n_amb = 0
     V = 0.0
     w_all = [np.concatenate([lams[0], np.conj(lams[0])])]
-    scale, osc_prev = _scale(lams[0]), is_complex(lams[0])  # of the last accepted speed
+    # of the last accepted speed: distance scale, oscillatory, far from the axis
+    scale, osc_prev, far_prev = _scale(lams[0]), is_complex(lams[0]), _far(lams[0])
     while V < v_max * (1 - 1e-12):
         nxt = next(s for s in stops if s > V * (1 + 1e-12))
         # a checkpoint within 10 % beyond the step is reached in this step (no sliver step)
@@ -161,9 +176,10 @@ def sweep_branches(
         new_l = w[pick]
         new_x = X[:, pick]
         new_x = new_x / np.sqrt(np.einsum("ij,ij->j", new_x.conj(), new_x).real)
-        osc_new = is_complex(new_l)
+        osc_new, far_new = is_complex(new_l), _far(new_l)
         osc = osc_new & osc_prev
-        change = float((np.abs(new_l - prev) / scale).max())
+        weight = np.where(far_prev & far_new, 0.5, 1.0)
+        change = float((np.abs(new_l - prev) / scale * weight).max())
         miss = float((np.abs(new_l - pred) / scale).max())
         slow = change <= 2 * max_rel_change
         ok = slow
@@ -184,7 +200,7 @@ def sweep_branches(
         vecs.append(new_x)
         w_all.append(w)
         V = V1
-        scale, osc_prev = _scale(new_l), osc_new
+        scale, osc_prev, far_prev = _scale(new_l), osc_new, far_new
         if progress is not None:
             progress(V)
         # the next step scales the one just taken (a step cut short to reach a checkpoint

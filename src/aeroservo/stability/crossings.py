@@ -27,8 +27,9 @@ __all__ = ["HUMP_ZETA", "SIGN_ZETA", "Verifier", "sign_changes", "branch_crossin
 
 HUMP_ZETA = 0.05
 """Interior extrema of Re(lambda) with |damping ratio| below this are refined between grid
-points (the step control keeps eigenvalue changes per step below 10 %, so a hump that crosses
-zero cannot hide behind grid values further from zero than this)."""
+points (the step control keeps eigenvalue changes per step below 10 %, or 20 % for a branch
+whose damping ratio is beyond 0.25 at both ends of the step, so a hump that crosses zero cannot
+hide behind grid values further from zero than this)."""
 
 SIGN_ZETA = 2e-3
 """Branch eigenvalues with |damping ratio| below this, or below 10 x the branch's measured
