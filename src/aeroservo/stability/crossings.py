@@ -169,32 +169,35 @@ def sign_changes(
         return float(brentq(fun, a, b, args=(k,), xtol=rtol * b, rtol=1e-15))
 
     out = []
-    for k in range(first, V.size - 1):
-        if (g[k] < 0) != (g[k + 1] < 0):
-            out.append((root(k, V[k], V[k + 1]), bool(g[k] < 0), k))
-    for k in range(first + 1, V.size - 1):
-        for sgn in (1.0, -1.0):
-            gk = sgn * g
-            # strictly above the left neighbour: a flat top of two equal grid values (a hump
-            # symmetric about their midpoint) is searched once, not twice
-            if not (gk[k] > gk[k - 1] and gk[k] >= gk[k + 1] and gk[k] < 0):
-                continue
-            if abs(zeta[k]) >= HUMP_ZETA:
-                continue
-            # search both grid intervals around the extreme, continuing from the left one
-            from scipy.optimize import minimize_scalar  # only for a hump (rare)
+    neg = g < 0
+    for k in (np.flatnonzero(neg[first:-1] != neg[first + 1 :]) + first).tolist():
+        out.append((root(k, V[k], V[k + 1]), bool(neg[k]), k))
+    # interior extrema of sgn * g below zero and near the axis: strictly above the left
+    # neighbour, so that a flat top of two equal grid values (a hump symmetric about their
+    # midpoint) is searched once, not twice
+    near = np.abs(zeta) < HUMP_ZETA
+    extrema = []
+    for sgn in (1.0, -1.0):
+        gk = sgn * g
+        top = np.zeros(g.size, dtype=bool)
+        top[1:-1] = (gk[1:-1] > gk[:-2]) & (gk[1:-1] >= gk[2:]) & (gk[1:-1] < 0) & near[1:-1]
+        top[: first + 1] = False
+        extrema += [(int(k), sgn) for k in np.flatnonzero(top)]
+    for k, sgn in sorted(extrema, key=lambda e: (e[0], -e[1])):
+        # search both grid intervals around the extreme, continuing from the left one
+        from scipy.optimize import minimize_scalar  # only for a hump (rare)
 
-            sol = minimize_scalar(
-                lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
-                bounds=(V[k - 1], V[k + 1]),
-                method="bounded",
-                options={"xatol": rtol * V[k + 1]},
-            )
-            if -sol.fun > 0:
-                vpk = float(sol.x)
-                kk = k - 1 if vpk < V[k] else k
-                out.append((root(kk, V[kk], vpk), sgn > 0, kk))
-                out.append((root(kk, vpk, V[kk + 1]), sgn < 0, kk))
+        sol = minimize_scalar(
+            lambda v, s=sgn, k=k: -s * fun(v, k - 1 if v < V[k] else k),
+            bounds=(V[k - 1], V[k + 1]),
+            method="bounded",
+            options={"xatol": rtol * V[k + 1]},
+        )
+        if -sol.fun > 0:
+            vpk = float(sol.x)
+            kk = k - 1 if vpk < V[k] else k
+            out.append((root(kk, V[kk], vpk), sgn > 0, kk))
+            out.append((root(kk, vpk, V[kk + 1]), sgn < 0, kk))
     return sorted(out)
 
 

@@ -78,6 +78,7 @@ class AeroelasticModel:
         self.matrices: AeroMatrices = replace(am, Cs=damping_matrix(self.damping, am.Ms, am.Ks))
         self.properties = element_properties(wing, self.mesh)
         self._systems: dict[tuple[float, float], FirstOrderSystem] = {}
+        self._parts: dict | None = None  # stiffness parts for label_modes
 
     def __repr__(self) -> str:
         damping = "" if not self.damping.active else f", damping={self.damping.describe()!r}"
@@ -143,11 +144,15 @@ class AeroelasticModel:
         ----------
         shapes : ndarray (n_q, n_modes)
         """
-        parts = self.matrices.stiffness_parts
+        if getattr(self, "_parts", None) is None:  # dense copies of small ones: cheaper products
+            small = self.n_dofs <= 200
+            self._parts = {
+                k: v.toarray() if small else v for k, v in self.matrices.stiffness_parts.items()
+            }
         shapes = np.asarray(shapes)
         energies = {
             name: np.real(np.einsum("ij,ij->j", shapes.conj(), np.asarray(k @ shapes)))
-            for name, k in parts.items()
+            for name, k in self._parts.items()
         }
         counts: dict[str, int] = {}
         labels = []
