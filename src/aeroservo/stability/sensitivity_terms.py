@@ -158,11 +158,11 @@ class Terms:
         """Fill the divergence derivatives of ``out``."""
         vd, rho = self.r.divergence_speed, self.rho
         mach = vd / self.a if self.matched else self.mach
-        k_st = _static(self.am, self.model.wagner, rho, mach)
+        base = pencil_blocks(self.am, self.model.wagner, rho, mach)
+        k_st = _static_of(base)
         F = self.am.Ks.toarray() + rho * vd * vd * k_st
         U, _, Vh = np.linalg.svd(F)
         u, q = U[:, -1], Vh[-1]
-        base = pencil_blocks(self.am, self.model.wagner, rho, mach)
         lam = base["Lam"].toarray()
         av = np.linalg.solve(lam, base["Ez"] @ q)
         bv = np.linalg.solve(lam.T, base["Dz"].T @ u)
@@ -203,7 +203,11 @@ class Terms:
 
 def _static(am, wagner, rho: float, mach) -> np.ndarray:
     """``K_static = Ka - Dz Lam^-1 Ez`` (dense) at a Mach number (complex: a complex step)."""
-    b = pencil_blocks(am, wagner, rho, mach)
+    return _static_of(pencil_blocks(am, wagner, rho, mach))
+
+
+def _static_of(b: dict) -> np.ndarray:
+    """``K_static`` of the pencil blocks ``b``."""
     lam = b["Lam"].toarray()
     return b["Ka"].toarray() - b["Dz"].toarray() @ np.linalg.solve(lam, b["Ez"].toarray())
 
