@@ -127,3 +127,17 @@ def test_bad_arguments(goland10, bad):
     kw = {"density": 1.225} | bad
     with pytest.raises(aes.InputError, match=list(bad)[0]):
         aes.flutter_boundary(goland10, **kw)
+
+
+def test_divergence_eigenvalues_kept_on_the_model_serve_every_density():
+    """The density-independent divergence eigenvalues kept on the model give, at other
+    densities and Mach numbers, the speeds of a fresh solve (and 1/sqrt(rho) scaling)."""
+    from aeroservo.stability.divergence import divergence_speeds
+
+    model = aes.AeroelasticModel(aes.examples.goland_aileron(), 8)
+    for rho, mach in ((1.225, 0.0), (0.4, 0.0), (0.9, 0.5), (0.2, 0.5)):
+        system = model.system(rho, mach)
+        cached = divergence_speeds(system, model)
+        np.testing.assert_array_equal(cached, divergence_speeds(system))
+    v1 = divergence_speeds(model.system(1.0), model)
+    np.testing.assert_allclose(divergence_speeds(model.system(0.25), model), 2.0 * v1, rtol=1e-12)
