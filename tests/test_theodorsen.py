@@ -88,3 +88,15 @@ def test_zero_chord_flap_has_no_aerodynamics():
     s = section_aero(0.8, -0.3, 1.0)
     for m in (s.Mnc, s.Cnc, s.Knc, s.Pq, s.Pd):
         assert np.all(m[:, 2] == 0) and np.all(m[2, :] == 0)
+
+
+def test_theodorsen_at_huge_reduced_frequency_quietly_one_half():
+    """C(k) -> 1/2 - i/(8k) for large k (A&S 9.2.7-8), without overflow warnings."""
+    import warnings
+
+    k = np.array([1e6, 1e10, 1e300])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = theodorsen_function(k)
+    np.testing.assert_allclose(c.real, 0.5, rtol=1e-12)
+    np.testing.assert_allclose(c.imag, -1.0 / (8.0 * k), rtol=1e-6)

@@ -101,14 +101,17 @@ def _hankel_ratio_asymptotic(x: np.ndarray) -> np.ndarray:
     S_nu = sum_k (-i)^k a_k(nu) / x^k, summed while the terms of the smallest x decrease
     (both sums as one product of the powers of 1/x with the coefficients)."""
     x_min = float(np.min(x))
-    table = np.zeros_like(_ASYMPTOTIC)
+    table = np.zeros_like(_ASYMPTOTIC)  # zero beyond each sum's last term
+    with np.errstate(over="ignore"):  # a huge x_min: its powers are inf, its terms 0
+        powers = x_min ** np.arange(60.0)
+    n_max = 1
     for i in range(2):
-        terms = _ASYMPTOTIC_ABS[i] / x_min ** np.arange(60)
+        terms = _ASYMPTOTIC_ABS[i] / powers
         stop = (terms[1:] >= terms[:-1]) | (terms[:-1] < 1e-17)  # term k is not added
         n = 1 + (int(np.argmax(stop)) if stop.any() else 59)
         table[i, :n] = _ASYMPTOTIC[i, :n]
-    n = int(np.flatnonzero(table.any(axis=0))[-1]) + 1
-    total = _powers(1.0 / x, n) @ table[:, :n].T
+        n_max = max(n_max, n)
+    total = _powers(1.0 / x, n_max) @ table[:, :n_max].T
     return 1j * total[:, 1] / total[:, 0]
 
 
