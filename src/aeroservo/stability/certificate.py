@@ -219,9 +219,9 @@ def _modal_aero(model, n_kept: int) -> tuple:
     """Modal (diagonal) aerodynamic terms of the in-vacuo modes above the first ``n_kept``:
     apparent mass, non-circulatory stiffness and damping, and per circulatory group its
     semichord with the downwash terms (cached on the model: they do not depend on density)."""
-    from .modal import _all_modes
+    from .modal import _all_modes, model_cache
 
-    cache = model.__dict__.setdefault("_modal_cache", {})
+    cache = model_cache(model)
     key = ("truncated", n_kept)
     if key not in cache:
         rest = _all_modes(model)[1][:, n_kept:]

@@ -17,6 +17,7 @@ import scipy.linalg as sla
 
 from ..errors import InputError, check_number
 from ..system.first_order import FirstOrderSystem
+from .modal import model_cache
 
 __all__ = ["divergence_speed", "divergence_speeds", "static_speeds"]
 
@@ -75,7 +76,7 @@ def divergence_speeds(system: FirstOrderSystem, model: object = None) -> np.ndar
     _check_system(system)
     if model is None:
         return static_speeds(system.Ks.toarray(), system.K_static, system.density)
-    cache = model.__dict__.setdefault("_modal_cache", {})
+    cache = model_cache(model)
     key = ("divergence", system.mach)
     if key not in cache:
         cache[key] = _divergence_eigenvalues(system.Ks.toarray(), system.K_static)

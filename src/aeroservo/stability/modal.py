@@ -107,9 +107,15 @@ def mode_rule(frequencies: np.ndarray, labels: list[str], n_min: int = MIN_MODES
     return n, cut, why
 
 
+def model_cache(model) -> dict:
+    """The results kept on a model between analyses (they do not depend on the density, or
+    carry it in their key)."""
+    return model.__dict__.setdefault("_modal_cache", {})
+
+
 def _all_modes(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """All in-vacuo modes of a model (cached on it: they do not depend on density)."""
-    cache = model.__dict__.setdefault("_modal_cache", {})
+    cache = model_cache(model)
     if "all" not in cache:
         am: AeroMatrices = model.matrices
         w2, phi = sla.eigh(am.Ks.toarray(), am.Ms.toarray())
@@ -241,7 +247,7 @@ def modal_system(model, density: float, basis: ModalBasis | None, mach: float = 
     wagner = wagner_set(model.wagner)
     if basis is None or basis.n_modes >= model.matrices.n_q:
         return ModalSystem(model.system(density, mach), None, None, wagner.n_terms)
-    cache = model.__dict__.setdefault("_modal_cache", {})
+    cache = model_cache(model)
     key = ("matrices", basis.n_modes)
     if key not in cache:
         am = model.matrices.project(basis.shapes)
