@@ -303,9 +303,25 @@ def test_lqg_closed_loop_boundary(case, G):
     assert b.stable_at_reference and b.flutter_speed > 1.1 * case.vf
 
 
-def test_mpc_has_no_linear_boundary(case):
+def test_mpc_boundary_is_that_of_its_law_and_a_python_law_is_refused(case):
+    """An MPC's closed-loop boundary is that of its law without active constraints (the LQG
+    whose gain is its first unconstrained move), built here as a plain compensator from the
+    law's matrices; a Python law has no linear boundary and is refused, never treated as open
+    loop."""
+    from aeroservo.design import DiscreteCompensator, python_law
+
+    m = make_mpc(case, horizon=5)
+    plant = lambda v: case.plant(v, filtered=True)  # noqa: E731
+    b = closed_loop_boundary(plant, m, 1.6 * case.vf, n_grid=9)
+    law = m.law()
+    bb = DiscreteCompensator(law.A, law.B, law.C, law.D, law.controls, law.sensors, law.dt)
+    b2 = closed_loop_boundary(plant, bb, 1.6 * case.vf, n_grid=9)
+    assert "MPC without active constraints" in b.info["law"]
+    assert [c["speed"] for c in b.crossings] == pytest.approx([c["speed"] for c in b2.crossings])
+    assert np.allclose(b.abscissa, b2.abscissa, rtol=1e-9, atol=1e-9)
+    law_fn = python_law(lambda t, y: [0.0], CONTROLS, SENSORS, sample_rate=1000.0)
     with pytest.raises(InputError, match="not linear"):
-        closed_loop_boundary(case.pb, make_mpc(case, horizon=5), 200.0)
+        closed_loop_boundary(case.pb, law_fn, 200.0)
 
 
 # -- time marching against python-control, determinism, disturbances --------------------------

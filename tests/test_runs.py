@@ -53,8 +53,12 @@ def test_every_shipped_scenario_runs(path, tmp_path, capsys):
         if spec.type != "none":
             assert summary["response"] == "decays" and summary["verdict"] == "stable"
             assert summary["open_loop_unstable"]
+            # issue 24: every shipped loop passes over its engaged range, judged as a black box
+            assert summary["passed"] and summary["engaged"]["stable_over_range"]
+            assert summary["engaged"]["margins_over_range"]["meets"]
+            assert "black box" in summary["margins"]["break_point"]
         else:
-            assert summary["verdict"] == "unstable" and summary["expect_unstable"]
+            assert summary["verdict"] == "unstable" and summary["expect_failure"]
 
 
 def test_simulation_summary_and_result_roundtrip(tmp_path):

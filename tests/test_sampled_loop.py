@@ -31,7 +31,7 @@ FAR = aes.design.Limits(magnitude={CONTROL: 1e12}, rate={CONTROL: 1e15})
 def setup():
     model = aes.AeroelasticModel(aes.examples.goland_aileron(), 10)
     vf = aes.flutter_boundary(model, RHO).flutter_speed
-    loop = ControlLoop(model, RHO, [CONTROL], SENSORS, ["tip_disp"])
+    loop = ControlLoop(model, RHO, [CONTROL], SENSORS, ["tip_disp"], design_modes=20)
     return model, vf, loop
 
 

@@ -22,6 +22,7 @@ OPTIMISTIC = (
     "tip_le_accel = 1.0e-4, tip_te_accel = 1.0e-4",
 )
 FAST_FILTERS = ("sensor_filter = 30.0 ", "sensor_filter = 100.0")
+EIGHT_MODES = ("design_modes = 20", "design_modes = 8 ")
 
 
 def variant(tmp_path, scenario: str, controller: str, *edits) -> object:
@@ -49,7 +50,7 @@ def test_unstable_design_gets_verdict_results_and_exit_3(tmp_path, capsys):
     """An LQG on 8 design modes with optimistic accelerometer noise and 100 Hz filters is unstable
     on the full plant: verdict "unstable", spectral radius > 1, one line with a hint, results
     still written, exit status 3."""
-    path = variant(tmp_path, "goland_aileron_lqg", "lqg.toml", OPTIMISTIC, FAST_FILTERS)
+    path = variant(tmp_path, "goland_aileron_lqg", "lqg.toml", OPTIMISTIC, FAST_FILTERS, EIGHT_MODES)
     out = tmp_path / "out"
     code = cli.main(["run", str(path), "--quick", "--json", "--out", str(out)])
     cap = capsys.readouterr()
@@ -75,7 +76,7 @@ def test_twelve_design_modes_no_longer_decays(tmp_path):
         "lqg.toml",
         OPTIMISTIC,
         FAST_FILTERS,
-        ("design_modes = 8 ", "design_modes = 12"),
+        ("design_modes = 20", "design_modes = 12"),
     )
     s = run_simulation(quick(load_scenario(path))).summary
     assert s["verdict"] == "unstable"
@@ -85,13 +86,14 @@ def test_twelve_design_modes_no_longer_decays(tmp_path):
 
 
 def test_expected_instability_exits_0(capsys, tmp_path):
-    """The shipped open-loop scenario sets ``simulation.expect_unstable``: verdict unstable,
+    """The shipped open-loop scenario sets ``simulation.expect_failure``: verdict unstable,
     exit 0, no hint on stderr."""
     path = ROOT / "scenarios" / "goland_aileron_open_loop.toml"
     code = cli.main(["run", str(path), "--quick", "--json", "--out", str(tmp_path)])
     cap = capsys.readouterr()
     summary = json.loads(cap.out)
-    assert code == 0 and summary["verdict"] == "unstable" and summary["expect_unstable"]
+    assert code == 0 and summary["verdict"] == "unstable" and summary["expect_failure"]
+    assert summary["passed"] is False
     assert "no controller acts" in summary["hint"]
     assert cap.err == ""
 

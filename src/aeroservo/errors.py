@@ -173,6 +173,7 @@ RANGES: dict[str, Range] = {
     "rayleigh_alpha": Range(0.0, 1e3, "1/s"),
     "rayleigh_beta": Range(0.0, 1.0, "s"),
     "estimator_variance": Range(0.0, 1e6, "signal units^2", lo_open=True),
+    "input_noise": Range(0.0, 1e12, "control units^2"),
 }
 """Allowed range of every physical quantity (documented in ``docs/conventions.md``)."""
 

@@ -103,47 +103,88 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(json_text(summary))
     else:
         print(_readable(summary))
-    if summary.get("verdict") == "unstable" and not scenario.expect_unstable:
+    for w in summary.get("warnings", []) if scenario.kind == "simulate" else []:
+        print(f"aeroservo: warning: {w}", file=sys.stderr)
+    if summary.get("passed") is False and not scenario.expect_failure:
         from ..studies.verdict import EXIT_UNSTABLE
 
         print(f"aeroservo: {summary['hint']}", file=sys.stderr)
         return EXIT_UNSTABLE
-    margins = summary.get("margins")
-    if margins and not margins["meets"] and summary.get("verdict") == "stable":
-        print(
-            f"aeroservo: warning: loop margins miss the requirement: "
-            f"{'; '.join(margins['violations'])}",
-            file=sys.stderr,
-        )
     return 0
 
 
-def _margin_lines(m: dict | None) -> list[str]:
-    """One line per control channel: gain, phase and disk margins at the actuator."""
-    if not m:
-        return []
+def _channel_text(c: dict) -> str:
+    """Gain, phase and disk margins of one break point."""
 
     def db(x, sign="+"):
         return f"{sign}inf" if x is None else f"{x:+.3g} dB"
 
+    if not c["stable"]:
+        return "closed loop unstable"
+    pm = "inf" if c["phase_margin_deg"] is None else f"{c['phase_margin_deg']:.3g} deg"
+    at = "" if c["phase_frequency"] is None else f" at {c['phase_frequency']:.3g} Hz"
+    return (
+        f"gain {db(c['gain_margin_db'])} / {db(c['gain_reduction_margin_db'], '-')}, "
+        f"phase {pm}{at}, disk {c['disk_margin']:.3g}"
+    )
+
+
+def _margin_lines(m: dict | None) -> list[str]:
+    """Margins at each break point, saying where the loop is broken."""
+    if not m:
+        return []
     r = m["requirement"]
     req = (
         f"disk {r['disk_alpha']:g}"
         if r["disk_alpha"] is not None
         else f"{r['gain_db']:g} dB, {r['phase_deg']:g} deg"
     )
-    out = []
+    out = [f"  margins at {m['speed']:.5g} m/s, broken at the {m['break_point']}:"]
     for name, c in m["channels"].items():
-        if not c["stable"]:
-            out.append(f"  margins at {name}: closed loop unstable")
-            continue
-        pm = "inf" if c["phase_margin_deg"] is None else f"{c['phase_margin_deg']:.3g} deg"
+        out.append(f"    {name}: {_channel_text(c)} ({'meets' if m['meets'] else 'misses'} {req})")
+    multi = m.get("multiloop") or {}
+    if len(m["channels"]) > 1 and multi.get("disk_margin") is not None:
+        out.append(f"    all inputs at once: disk {multi['disk_margin']:.3g} ({multi['method']})")
+    if m.get("peak_sensitivity") is not None:
         out.append(
-            f"  margins at {name}: gain {db(c['gain_margin_db'])} / "
-            f"{db(c['gain_reduction_margin_db'], '-')}, phase {pm}, disk {c['disk_margin']:.3g} "
-            f"({'meets' if m['meets'] else 'misses'} {req})"
+            f"    peak |S| {m['peak_sensitivity']:.3g} at {m['peak_sensitivity_frequency']:.3g} "
+            f"Hz, peak |T| {m['peak_complementary_sensitivity']:.3g} at "
+            f"{m['peak_complementary_sensitivity_frequency']:.3g} Hz (plant input)"
         )
+    for name, c in m.get("sensors", {}).items():
+        out.append(f"    at sensor {name} (plant output): {_channel_text(c)}")
     return out
+
+
+def _engaged_lines(s: dict) -> list[str]:
+    """The engaged range, its stability and its margins."""
+    e = s.get("engaged")
+    if not e:
+        return []
+    r = e["engaged_range"]
+    head = (
+        f"  engaged {r['low']:.5g}-{r['high']:.5g} m/s ({r['source']}), stability required to "
+        f"{r['stable_to']:.5g} m/s ({r['flutter_margin']:g} x): "
+    )
+    if e["stable_over_range"]:
+        head += "stable throughout"
+    else:
+        parts = [
+            f"{u['from']:.5g}-{u['to']:.5g} m/s ({u['kind']})"
+            for u in e.get("unstable_intervals", [])
+        ]
+        head += "UNSTABLE at " + (
+            "; ".join(parts) or ", ".join(f"{v:.5g}" for v in e.get("unstable_speeds", []))
+        )
+    mr = e["margins_over_range"]
+    if mr["meets"] is None:
+        head += f"; margins {mr.get('note', 'not judged')}"
+    else:
+        n, bad = len(mr["speeds"]), len(mr["failures"])
+        head += f"; margins meet the requirement at {n - bad} of {n} speeds" + (
+            "" if mr["meets"] else " (FAIL)"
+        )
+    return [head]
 
 
 def _readable(s: dict) -> str:
@@ -179,13 +220,17 @@ def _readable(s: dict) -> str:
                 f"growth {v['growth']:.3g}"
             )
         if "verdict" in s:
-            expected = " (expected: simulation.expect_unstable)" if s.get("expect_unstable") else ""
+            expected = " (expected: simulation.expect_failure)" if s.get("expect_failure") else ""
+            rho = s["spectral_radius"]
+            radius = "" if rho is None else f"spectral radius of the sampled loop {rho:.6g}, "
             lines.append(
-                f"  verdict {s['verdict']}{expected}: spectral radius of the sampled loop "
-                f"{s['spectral_radius']:.6g}, response {s['response']}"
+                f"  verdict {s['verdict']}, {'passed' if s['passed'] else 'FAILED'}{expected}: "
+                f"{radius}response {s['response']}"
                 + (f" ({', '.join(s['growing_signals'])} grow)" if s["growing_signals"] else "")
             )
         lines += _margin_lines(s.get("margins"))
+        lines += _engaged_lines(s)
+        lines += [f"  warning: {w}" for w in s.get("warnings", [])]
         if "mpc" in s:
             m = s["mpc"]
             lines.append(
@@ -196,8 +241,9 @@ def _readable(s: dict) -> str:
             c = s["closed_loop"]
             lines.append(
                 f"  closed loop loses stability at {f(c['closed_loop_flutter_speed'], ' m/s')}"
-                f" ({c['closed_loop_instability'] or 'not in range'}); "
-                f"stable intervals {[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
+                f" ({c['closed_loop_instability'] or 'not in range'}), lower end "
+                f"{f(c['lower_speed'], ' m/s')}; stable intervals "
+                f"{[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
             )
     else:
         lines.append(

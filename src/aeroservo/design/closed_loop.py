@@ -19,15 +19,18 @@ cross zero between grid points.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number
+from ..linear.signals import describe
 from ..stability.boundary import sign_changes
+from .boundary_result import ClosedLoopBoundary
+from .interface import as_controller, has_linear_law
+from .law import pad_state_map
 from .plant import SampledPlant, select
-from .sampled_loop import _pad, linear_law, loop_matrix
+from .sampled_loop import linear_law, loop_matrix, plant_states
 
 __all__ = ["ClosedLoopBoundary", "closed_loop_boundary", "closed_loop_matrix"]
 
@@ -37,7 +40,27 @@ def _controller_at(controller, speed: float):
     return controller.at(speed) if hasattr(controller, "at") else controller
 
 
-def closed_loop_matrix(plant, controller, *, sampled: bool = True, delay: bool = False):
+def linear_controller(controller, who: str, sample_rate: float | None = None):
+    """The controller through :func:`~aeroservo.design.as_controller`, refused unless it has a
+    linear law (``who`` names the analysis in the message)."""
+    ctrl = as_controller(controller, sample_rate=sample_rate)
+    if not has_linear_law(ctrl):
+        raise InputError(
+            f"{who}: controller = {describe(controller)} is not linear (a Python law or a "
+            "protocol object): it has no closed-loop eigenvalues or margins; simulate it, or "
+            "bring its matrices (aeroservo.design.as_controller(control.ss(A, B, C, D, dt)))"
+        )
+    return ctrl
+
+
+def closed_loop_matrix(
+    plant,
+    controller,
+    *,
+    sampled: bool = True,
+    delay: bool = False,
+    sample_rate: float | None = None,
+):
     """State matrix of the loop of a linear controller around a plant at one speed.
 
     The sampled loop is the one :func:`aeroservo.simulate.simulate` marches
@@ -48,12 +71,16 @@ def closed_loop_matrix(plant, controller, *, sampled: bool = True, delay: bool =
     ----------
     plant : control.StateSpace
         Continuous plant with the controller's control inputs and sensors.
-    controller : StateFeedback, OutputFeedback, MPCController or a compensator
-        Linear controller (see :mod:`aeroservo.design`).
+    controller
+        A linear controller (see :func:`aeroservo.design.as_controller`; a schedule is
+        evaluated at the plant's speed).
     sampled : bool
-        True: the discrete loop at the controller's sample rate; False: the continuous loop.
+        True: the discrete loop at the controller's sample rate; False: the continuous loop
+        (continuous LQR and LQG designs only).
     delay : bool
         One-sample computational delay (sampled loop only).
+    sample_rate : float, optional
+        [Hz] for a continuous python-control compensator (discretised by Tustin's method).
 
     Returns
     -------
@@ -64,16 +91,25 @@ def closed_loop_matrix(plant, controller, *, sampled: bool = True, delay: bool =
     """
     import control
 
+    controller = linear_controller(controller, "closed_loop_matrix", sample_rate)
+    controller = _controller_at(controller, float(getattr(plant, "speed", np.nan)))
     controls = list(controller.controls)
     if sampled:
-        law = linear_law(controller, plant.nstates)
-        sp = SampledPlant.from_statespace(plant, controller.dt, controls, (), list(law.sensors))
-        return loop_matrix(sp, law, delay), controller.dt
+        law = linear_law(controller, plant_states(plant))
+        sp = SampledPlant.from_statespace(plant, law.dt, controls, (), list(law.sensors))
+        return loop_matrix(sp, law, delay), law.dt
     if delay:
         raise InputError("closed_loop_matrix: delay applies to the sampled loop only")
+    if not hasattr(controller, "K") or not (
+        hasattr(controller, "state_map") or hasattr(controller, "compensator_continuous")
+    ):
+        raise InputError(
+            "closed_loop_matrix: sampled=False needs a continuous design (LQR or LQG); "
+            f"{describe(controller)} is a sampled controller"
+        )
     if getattr(controller, "needs_state", False):  # state feedback
         A, B, _, _ = select(plant, controls, [])
-        return A - B @ (controller.K @ _pad(controller.state_map, plant.nstates)), None
+        return A - B @ (controller.K @ pad_state_map(controller.state_map, plant.nstates)), None
     sensors = list(controller.sensors)
     A, B, C, D = select(plant, controls, sensors)
     p = control.ss(A, B, C, D)
@@ -93,155 +129,6 @@ def _measure(A: np.ndarray, dt: float | None) -> tuple[float, complex]:
     return float(np.log(abs(lam[i])) / dt), complex(s.real, abs(s.imag))
 
 
-@dataclass
-class ClosedLoopBoundary:
-    """Closed-loop stability of a linear controller versus airspeed.
-
-    Attributes
-    ----------
-    speeds : ndarray
-        Grid speeds [m/s].
-    abscissa : ndarray
-        Stability measure on the grid [1/s]: growth rate of the least stable closed-loop pole
-        (negative: stable).
-    frequencies : ndarray
-        Frequency of that pole on the grid [Hz].
-    crossings : list of dict
-        ``{"speed" [m/s], "frequency" [Hz], "kind": "onset" | "recovery", "static": bool}``
-        in increasing speed; ``static`` marks a real pole through zero (divergence-like, 0 Hz).
-    sampled : bool
-        Whether the measure is that of the sampled loop.
-    delay : bool
-        Whether the loop has a one-sample computational delay.
-    reference_speed : float
-        Speed [m/s] whose stable interval defines :attr:`flutter_speed`.
-    """
-
-    speeds: np.ndarray
-    abscissa: np.ndarray
-    frequencies: np.ndarray
-    crossings: list
-    sampled: bool
-    reference_speed: float
-    info: dict = field(default_factory=dict)
-    delay: bool = False
-    reference_abscissa: float | None = None
-
-    @property
-    def stable_at_reference(self) -> bool:
-        """Whether the loop is stable at the reference (e.g. design) speed (from its own
-        eigenvalues when computed, else interpolated on the grid)."""
-        g = self.reference_abscissa
-        return bool((self._g(self.reference_speed) if g is None else g) < 0)
-
-    def _g(self, v: float) -> float:
-        return float(np.interp(v, self.speeds, self.abscissa))
-
-    @property
-    def flutter(self) -> dict | None:
-        """First onset above the reference speed (None: stable to the end of the range)."""
-        ons = [c for c in self.crossings if c["kind"] == "onset"]
-        above = [c for c in ons if c["speed"] >= self.reference_speed]
-        return above[0] if above else None
-
-    @property
-    def flutter_speed(self) -> float | None:
-        """Closed-loop flutter speed [m/s]: where the loop first loses stability above the
-        reference speed, through a complex pair (flutter) or a real pole (``static`` in
-        :attr:`flutter`); None if it stays stable up to the end of the range."""
-        f = self.flutter
-        return None if f is None else float(f["speed"])
-
-    @property
-    def flutter_frequency(self) -> float | None:
-        """Frequency [Hz] of the closed-loop flutter onset."""
-        f = self.flutter
-        return None if f is None else float(f["frequency"])
-
-    def stable_intervals(self) -> list[tuple[float, float]]:
-        """Speed intervals [m/s] inside the searched range where the loop is stable.
-
-        Between two crossings the loop is stable after a recovery and unstable after an onset
-        (the crossing kinds come from the refined roots, not from the coarse grid, which can
-        step over a short unstable interval); before the first crossing it is the opposite of
-        that crossing.
-        """
-        edges = [self.speeds[0]] + [c["speed"] for c in self.crossings] + [self.speeds[-1]]
-        if self.crossings:
-            first = self.crossings[0]["kind"] == "onset"
-            stable = [first] + [c["kind"] == "recovery" for c in self.crossings]
-        else:
-            stable = [bool(np.all(self.abscissa < 0))]
-        out = []
-        for a, b, ok in zip(edges[:-1], edges[1:], stable, strict=True):
-            if b > a and ok:
-                out.append((float(a), float(b)))
-        return out
-
-    def to_dict(self) -> dict:
-        """JSON-ready summary (m/s, Hz)."""
-        f = self.flutter
-        return {
-            "closed_loop_flutter_speed": self.flutter_speed,
-            "closed_loop_flutter_frequency": self.flutter_frequency,
-            "closed_loop_instability": None
-            if f is None
-            else (
-                "static (real pole, divergence-like)" if f["static"] else "oscillatory (flutter)"
-            ),
-            "reference_speed": self.reference_speed,
-            "stable_at_reference": self.stable_at_reference,
-            "sampled": self.sampled,
-            "delay": self.delay,
-            "crossings": self.crossings,
-            "stable_intervals": self.stable_intervals(),
-            "v_range": [float(self.speeds[0]), float(self.speeds[-1])],
-        }
-
-    def plot(self, ax=None, open_loop=None):
-        """Growth rate of the least stable pole versus speed, crossings marked.
-
-        Parameters
-        ----------
-        ax : matplotlib Axes, optional
-        open_loop : FlutterResult, optional
-            Adds the open-loop tracked modes' real parts for comparison.
-        """
-        from matplotlib.figure import Figure
-
-        if ax is None:
-            fig = Figure(layout="constrained", figsize=(7, 3.6))
-            ax = fig.subplots()
-        else:
-            fig = ax.figure
-        if open_loop is not None:
-            ol = np.max(open_loop.eigenvalues.real, axis=1)
-            ax.plot(open_loop.speeds, ol, color="0.6", lw=1, label="open loop (tracked modes)")
-            if open_loop.flutter_speed is not None:
-                ax.axvline(open_loop.flutter_speed, color="0.6", ls=":", lw=1)
-        ax.plot(self.speeds, self.abscissa, label="closed loop")
-        ax.axhline(0, color="k", lw=0.8)
-        ax.axvline(self.reference_speed, color="g", ls="--", lw=1, label="design speed")
-        for c in self.crossings:
-            ax.plot(c["speed"], 0, "ro" if c["kind"] == "onset" else "bs")
-        if self.flutter_speed is not None:
-            ax.annotate(
-                f"closed-loop flutter {self.flutter_speed:.4g} m/s",
-                (self.flutter_speed, 0),
-                xytext=(10, 20),
-                textcoords="offset points",
-                arrowprops={"arrowstyle": "->"},
-            )
-        lo, hi = np.percentile(self.abscissa, [2, 98])
-        pad = 0.2 * (hi - lo + 1e-9)
-        ax.set_ylim(min(lo, -pad) - pad, max(hi, pad) + pad)
-        ax.set_xlabel("airspeed V [m/s]")
-        ax.set_ylabel("growth rate of least stable pole [1/s]")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-        return fig
-
-
 @blas_limited
 def closed_loop_boundary(
     plant_at: Callable[[float], object],
@@ -255,6 +142,7 @@ def closed_loop_boundary(
     delay: bool = False,
     rtol: float = 1e-7,
     progress: Callable[[float], None] | None = None,
+    sample_rate: float | None = None,
 ) -> ClosedLoopBoundary:
     """Closed-loop flutter boundary of a linear controller.
 
@@ -264,8 +152,9 @@ def closed_loop_boundary(
         The plant at a speed: a :class:`~aeroservo.design.loop.ControlLoop` (its sampled
         plants, cached), a builder (its ``at``) or ``V -> control.StateSpace`` (e.g. with
         sensor filters added).
-    controller : StateFeedback, OutputFeedback or GainSchedule
-        Linear controller; a schedule is evaluated at each speed.
+    controller
+        A linear controller (:func:`aeroservo.design.as_controller`); a schedule is evaluated
+        at each speed; an MPC by its law without active constraints. A Python law is refused.
     v_max : float
         Upper end of the speed range [m/s].
     v_min : float, optional
@@ -282,15 +171,14 @@ def closed_loop_boundary(
         Relative tolerance on crossing speeds.
     progress : callable, optional
         Called with each grid speed [m/s].
+    sample_rate : float, optional
+        [Hz] for a continuous python-control compensator.
 
     Returns
     -------
     ClosedLoopBoundary
     """
-    if getattr(controller, "is_linear", True) is False:
-        raise InputError(
-            "closed_loop_boundary: the controller is not linear (MPC); simulate it instead"
-        )
+    controller = linear_controller(controller, "closed_loop_boundary", sample_rate)
     v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
     v_min = v_max / 20.0 if v_min is None else v_min
     v_min = check_number("v_min", v_min, unit="m/s", lo=0.0, hi=v_max, lo_open=True, hi_open=True)
@@ -306,6 +194,7 @@ def closed_loop_boundary(
 
     cached = getattr(plant_at, "sampled_plant", None) if sampled else None
     known: dict[float, tuple[float, complex]] = {}  # the root finder starts at grid points
+    source: list[str] = []
 
     def evaluate(v: float) -> tuple[float, complex]:
         v = float(v)
@@ -314,11 +203,15 @@ def closed_loop_boundary(
         n_eval[0] += 1
         ctrl = _controller_at(controller, v)
         if cached is not None:  # a ControlLoop: its sampled plants are reused across designs
-            law = linear_law(ctrl, plant_at.n_plant_states)
-            sp = cached(v, ctrl.dt, list(ctrl.controls), list(law.sensors))
-            known[v] = _measure(loop_matrix(sp, law, delay), ctrl.dt)
+            law = linear_law(ctrl, plant_at.state_labels)
+            source[:] = [law.source]
+            sp = cached(v, law.dt, list(law.controls), list(law.sensors))
+            known[v] = _measure(loop_matrix(sp, law, delay), law.dt)
         else:
-            A, dt = closed_loop_matrix(at(v), ctrl, sampled=sampled, delay=delay)
+            plant = at(v)
+            if sampled:
+                source[:] = [linear_law(ctrl, plant_states(plant)).source]
+            A, dt = closed_loop_matrix(plant, ctrl, sampled=sampled, delay=delay)
             known[v] = _measure(A, dt)
         return known[v]
 
@@ -351,7 +244,7 @@ def closed_loop_boundary(
         crossings=crossings,
         sampled=sampled,
         reference_speed=float(reference_speed),
-        info={"n_evaluations": n_eval[0]},
+        info={"n_evaluations": n_eval[0], "law": source[0] if source else ""},
         delay=bool(delay),
         reference_abscissa=g_ref,
     )

@@ -16,7 +16,8 @@ The design follows the loop of :mod:`aeroservo.design.sampled_loop` exactly:
    ``gamma_factor`` times the optimal gamma (the optimal one has poles near infinity, which the
    bilinear map sends to z = -1);
 5. the controller is mapped back by the same bilinear map and unscaled: a discrete compensator
-   ``c[k] = Cc s[k] + Dc y[k]``, ``s[k+1] = Ac s[k] + Bc y[k]``.
+   ``c[k] = Cc s[k] + Dc y[k]``, ``s[k+1] = Ac s[k] + Bc y[k]`` (with anti-windup,
+   :mod:`aeroservo.design.compensator`).
 
 Weights (frequencies in Hz, prewarped): ``W1 = (s/M_S + wb) / (s + wb A_S)`` bounds ``|Si|`` by
 ``gamma A_S`` below ``bandwidth`` and ``gamma M_S`` above; ``W2 = c (s/wr + 1) / (s/(20 wr) + 1)``
@@ -29,12 +30,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number, check_quantity
+from .compensator import DiscreteCompensator
 from .plant import SampledPlant
 
 __all__ = ["HinfWeights", "DiscreteCompensator", "hinf"]
@@ -84,69 +86,6 @@ class HinfWeights:
                 f"hinf.sensitivity_floor = {self.sensitivity_floor:g}: must be below "
                 f"hinf.sensitivity_peak = {self.sensitivity_peak:g}"
             )
-
-
-@dataclass
-class DiscreteCompensator:
-    """A linear discrete compensator from the sensors to the commands (H-infinity).
-
-    ``c[k] = Cc s[k] + Dc y[k]``, ``s[k+1] = Ac s[k] + Bc y[k]`` (physical units: sensors in
-    their units, commands in N m). Its state does not see the actuator limits (no anti-windup).
-
-    Attributes
-    ----------
-    Ac, Bc, Cc, Dc : ndarray
-    controls, sensors : tuple of str
-    dt : float
-        Sample period [s].
-    design_speed : float
-        [m/s]
-    info : dict
-        ``gamma``, ``gamma_optimal``, ``order`` (controller states), ``model_order`` (reduced
-        design model), ``reduction_error`` (largest relative channel error of the reduction).
-    """
-
-    Ac: np.ndarray
-    Bc: np.ndarray
-    Cc: np.ndarray
-    Dc: np.ndarray
-    controls: tuple
-    sensors: tuple
-    dt: float
-    design_speed: float = float("nan")
-    info: dict = field(default_factory=dict)
-    needs_state: bool = False
-
-    def __post_init__(self) -> None:
-        self.reset()
-
-    def compensator_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        return self.Ac, self.Bc, self.Cc, self.Dc
-
-    @property
-    def compensator(self):
-        """The compensator as a discrete ``control.StateSpace`` (sensors in, commands out)."""
-        import control
-
-        return control.ss(
-            self.Ac,
-            self.Bc,
-            self.Cc,
-            self.Dc,
-            self.dt,
-            inputs=list(self.sensors),
-            outputs=list(self.controls),
-            name="hinf",
-        )
-
-    def reset(self) -> None:
-        self.s = np.zeros(self.Ac.shape[0])
-
-    def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
-        return self.Cc @ self.s + self.Dc @ y
-
-    def update(self, y: np.ndarray, u: np.ndarray) -> None:
-        self.s = self.Ac @ self.s + self.Bc @ y
 
 
 def _to_w_plane(A, B, C, D, dt: float):
@@ -278,6 +217,7 @@ def hinf(
         tuple(sensors),
         dt,
         design_speed=float(getattr(sys, "speed", np.nan)),
+        source="H-infinity",
         info={
             "gamma": float(out[0]),
             "gamma_optimal": float(g_opt),

@@ -23,7 +23,9 @@ import numpy as np
 from ..errors import InputError, check_int, check_number
 from ..linear.models import tip_deflection_state
 from ..linear.state_space import StateSpaceBuilder
+from .compensator import compensator_from_lti
 from .hinf import hinf
+from .interface import python_law, static_gain
 from .lqg import lqg
 from .lqr import Bryson, lqr
 from .mpc import mpc
@@ -155,6 +157,15 @@ class ControlLoop:
         return self.plant_builder.n_states + self.n_filter_states
 
     @property
+    def state_labels(self) -> tuple[str, ...]:
+        """Names of the full plant's states, filter states (``<sensor>_filter<i>``) last."""
+        names = tuple(self.plant_builder.state_labels)
+        if self.sensor_filter is None:
+            return names
+        k = self.filter_order
+        return names + tuple(f"{s}_filter{i + 1}" for s in self.filtered for i in range(k))
+
+    @property
     def n_filter_states(self) -> int:
         return self.filter_order * len(self.filtered) if self.sensor_filter is not None else 0
 
@@ -196,13 +207,18 @@ class ControlLoop:
 
         Returns
         -------
-        OpenLoop, StateFeedback, OutputFeedback, GainSchedule, MPCController or
-        DiscreteCompensator
+        OpenLoop, StateFeedback, OutputFeedback, GainSchedule, MPCController,
+        DiscreteCompensator, StateGain or PythonLaw
         """
         self.check_spec(spec)
         rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
         if spec.type == "none":
             return OpenLoop(tuple(self.controls), 1.0 / rate)
+        if spec.type in ("linear", "gain", "python"):
+            try:
+                return brought_controller(spec, self.controls, self.sensors, rate)
+            except InputError as exc:
+                raise InputError(f"{spec.source}: {exc}") from None
         if spec.type == "hinf":
             try:
                 return hinf(
@@ -224,6 +240,7 @@ class ControlLoop:
                 limits=spec.limits,
                 process_noise=spec.process_noise,
                 sensor_noise=spec.sensor_noise,
+                input_noise=spec.input_noise,
                 horizon=spec.horizon,
                 bryson=self.bryson(spec),
                 soft_outputs=spec.soft_outputs or None,
@@ -247,6 +264,7 @@ class ControlLoop:
                 self.sensors,
                 process_noise=spec.process_noise,
                 sensor_noise=spec.sensor_noise,
+                input_noise=spec.input_noise,
                 bryson=self.bryson(spec),
                 sample_rate=rate,
             )
@@ -258,6 +276,49 @@ class ControlLoop:
         ctrl: GainSchedule = schedule(one, [f * flutter_speed for f in spec.schedule])
         ctrl.design_speed = speed
         return ctrl
+
+
+def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
+    """The controller of a ``linear``, ``gain`` or ``python`` spec at the loop's sample rate
+    ``rate`` [Hz] (a continuous compensator discretised by the spec's method)."""
+    import control
+
+    if spec.type == "linear":
+        c = spec.linear
+        dt = True if c["dt"] is None else c["dt"]
+        sys = control.ss(
+            c["A"], c["B"], c["C"], c["D"], dt, inputs=c["inputs"], outputs=c["outputs"]
+        )
+        ctrl = compensator_from_lti(
+            sys,
+            sample_rate=rate,
+            method=c.get("method", "tustin"),
+            prewarp=c.get("prewarp"),
+            sign=c.get("sign", 1),
+            anti_windup=None
+            if c.get("anti_windup", True)
+            else np.zeros((sys.nstates, sys.noutputs)),
+            source=f"compensator from {c['source']}",
+        )
+        return ctrl
+    if spec.type == "gain":
+        g = spec.gain
+        return static_gain(
+            g["K"],
+            g["controls"],
+            sensors=g.get("sensors"),
+            states=g.get("states"),
+            sample_rate=rate,
+        )
+    p = spec.python
+    return python_law(
+        p["function"],
+        controls,
+        p.get("sensors") or sensors,
+        sample_rate=rate,
+        needs_state=p.get("needs_state", False),
+        name=p.get("source", "Python law"),
+    )
 
 
 def check_spec_signals(
@@ -279,7 +340,13 @@ def check_spec_signals(
         "limits.rate": list(controls),
         "estimator.process_noise": ["gust"],
         "estimator.sensor_noise": list(sensors),
+        "estimator.input_noise": list(controls),
         "mpc.soft_outputs": outputs,
+        "linear inputs": outputs,
+        "linear outputs": list(controls),
+        "gain.controls": list(controls),
+        "gain.sensors": outputs,
+        "python.sensors": outputs,
     }
     for key, names in spec.signals.items():
         for n in names:

@@ -23,10 +23,12 @@ import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..errors import InputError, check_number, check_quantity
+from .law import LinearLaw
 from .lqr import Bryson, _balanced_lqr, cost_weights
 from .plant import SampledPlant, select
+from .riccati import solve_dare
 
-__all__ = ["KalmanFilter", "kalman_filter", "OutputFeedback", "lqg"]
+__all__ = ["KalmanFilter", "kalman_filter", "OutputFeedback", "lqg", "estimator_law"]
 
 
 @dataclass
@@ -60,6 +62,7 @@ def kalman_filter(
     sensors: Sequence[str],
     process_noise: dict,
     sensor_noise: dict,
+    input_noise: dict | None = None,
 ) -> KalmanFilter:
     """Steady-state Kalman filter of a sampled plant (augmented with the held command).
 
@@ -72,6 +75,12 @@ def kalman_filter(
         ``{disturbance input: variance of its sampled value}`` (e.g. ``{"gust": 1.0}`` (m/s)^2).
     sensor_noise : dict
         ``{sensor: variance}`` in the sensor's unit squared; every sensor needs one.
+    input_noise : dict, optional
+        ``{control: q^2}``: fictitious noise entering with each control [unit^2], for loop
+        transfer recovery at the plant input (Doyle & Stein, "Robustness with observers", IEEE
+        TAC 24(4), 1979; Maciejowski, *Multivariable Feedback Design*, sec. 5.6): the process
+        noise gains ``q^2 Bu Bu'`` (``Bu`` the control's column of the augmented model), and as
+        ``q^2`` grows the LQG's loop at the plant input tends to the LQR's.
     """
     missing = [s for s in sensors if s not in sensor_noise]
     if missing:
@@ -91,49 +100,17 @@ def kalman_filter(
     G = Bd[:, cols]
     W = np.diag([process_noise[d] for d in process_noise])
     V = np.diag([sensor_noise[s] for s in sensors])
+    Qn = G @ W @ G.T
+    for c, q2 in (input_noise or {}).items():
+        if c not in plant.controls:
+            raise InputError(f"input_noise: {c!r} is not a control input {list(plant.controls)}")
+        b = Bu[:, plant.controls.index(c)]
+        Qn = Qn + check_number(f"input noise of {c!r}", q2, lo=0.0) * np.outer(b, b)
     # filter-form gain from the a-priori covariance of the DARE (balanced for conditioning)
-    P = _dare_balanced(Ad, Ca, G @ W @ G.T, V)
+    P = _dare_balanced(Ad, Ca, Qn, V)
     S = Ca @ P @ Ca.T + V
     M = np.linalg.solve(S.T, (P @ Ca.T).T).T
     return KalmanFilter(Ad, Bu, Ca, M)
-
-
-def solve_dare(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """Stabilizing solution X of ``X = A'XA - A'XB (R + B'XB)^-1 B'XA + Q``.
-
-    Structured doubling algorithm (Chu, Fan, Lin & Wang 2004): quadratically convergent, no
-    eigenvalue reordering, hence robust for the many lightly damped structural poles close to the
-    unit circle that defeat Schur/QZ-based solvers here. Solved in coordinates equilibrated by a
-    diagonal similarity; the residual is checked.
-    """
-    n = A.shape[0]
-    _, (t, _) = sla.matrix_balance(A, permute=False, separate=True)
-    Ak = A * (1.0 / t)[:, None] * t[None, :]
-    Bt = B / t[:, None]
-    Gk = Bt @ np.linalg.solve(R, Bt.T)
-    Hk = Q * t[:, None] * t[None, :]
-    I = np.eye(n)
-    A0, Q0 = Ak.copy(), Hk.copy()
-    for _ in range(100):
-        W = np.linalg.solve(I + Gk @ Hk, np.hstack([Ak, Gk]))
-        W1, W2 = W[:, :n], W[:, n:]
-        H_next = Hk + Ak.T @ Hk @ W1
-        Gk = Gk + Ak @ W2 @ Ak.T
-        Ak = Ak @ W1
-        step = np.linalg.norm(H_next - Hk)
-        Hk = 0.5 * (H_next + H_next.T)
-        if step <= 1e-14 * np.linalg.norm(Hk):
-            break
-    # residual in the balanced coordinates, relative to the terms that cancel
-    Xb = Hk
-    axa = A0.T @ Xb @ A0
-    S = R + Bt.T @ Xb @ Bt
-    corr = A0.T @ Xb @ Bt @ np.linalg.solve(S, Bt.T @ Xb @ A0)
-    res = axa - corr + Q0 - Xb
-    scale = np.linalg.norm(axa) + np.linalg.norm(corr) + np.linalg.norm(Q0) + np.linalg.norm(Xb)
-    if not np.linalg.norm(res) <= 1e-8 * scale:
-        raise ArithmeticError("discrete Riccati equation: the doubling iteration did not converge")
-    return Xb / t[:, None] / t[None, :]
 
 
 def _dare_balanced(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np.ndarray:
@@ -167,10 +144,15 @@ class OutputFeedback:
     design_speed: float = float("nan")
     needs_state: bool = False
 
+    def law(self, states=()) -> LinearLaw:
+        """Its :class:`~aeroservo.design.law.LinearLaw` (the estimator predicts with the input
+        applied: ``L = Bu``)."""
+        return estimator_law(self.K, self.kf, self.controls, self.sensors, self.dt, "LQG")
+
     @property
     def compensator(self):
         """Discrete compensator (``control.StateSpace``) from sensors to controls, valid while
-        no actuator limit is active."""
+        no actuator limit is active: the controller seen as a black box."""
         return discrete_compensator(self.K, self.kf, self.dt, self.sensors, self.controls)
 
     @property
@@ -197,6 +179,7 @@ def lqg(
     *,
     process_noise: dict,
     sensor_noise: dict,
+    input_noise: dict | None = None,
     Q: np.ndarray | None = None,
     R: np.ndarray | None = None,
     bryson: Bryson | None = None,
@@ -212,6 +195,8 @@ def lqg(
     controls, sensors : sequence of str
     process_noise, sensor_noise : dict
         See :func:`kalman_filter` (variances of the sampled signals).
+    input_noise : dict, optional
+        Loop transfer recovery at the plant input, see :func:`kalman_filter`.
     Q, R, bryson :
         LQR weights, see :func:`aeroservo.design.lqr.lqr`.
     sample_rate : float
@@ -230,7 +215,7 @@ def lqg(
     Q, R, N = cost_weights(sys, controls, Q, R, bryson, "lqg")
     dist = tuple(process_noise)
     sp = SampledPlant.from_statespace(sys, dt, controls, dist, list(sensors))
-    kf = kalman_filter(sp, sensors, process_noise, sensor_noise)
+    kf = kalman_filter(sp, sensors, process_noise, sensor_noise, input_noise)
     Ad, Bu, _, Ca = sp.augmented()
     # LQR on the augmented model [x, h]: no weight on the held command states
     Qa = np.zeros((n + m, n + m))
@@ -257,25 +242,38 @@ def lqg(
     )
 
 
-def discrete_compensator(K, kf: KalmanFilter, dt: float, sensors, controls):
-    """Linear discrete LQG compensator (filter form) as a ``control.StateSpace``.
+def estimator_law(K, kf: KalmanFilter, controls, sensors, dt: float, source: str) -> LinearLaw:
+    """The law of a Kalman filter (filter form) with the gain ``K`` on its estimate.
 
     State: the a-priori estimate ``xi-``; ``c = -K (I - M Ca) xi- - K M y`` and
-    ``xi-[k+1] = (Ad - Bu K)(I - M Ca) xi- + (Ad - Bu K) M y``.
+    ``xi-[k+1] = Ad xi+ + Bu u = (Ad - Bu K)(I - M Ca) xi- + (Ad - Bu K) M y + Bu (u - c)``.
     """
-    import control
-
     F = np.eye(kf.Ad.shape[0]) - kf.M @ kf.Ca
     AK = kf.Ad - kf.Bu @ K
-    return control.ss(
+    return LinearLaw(
         AK @ F,
         AK @ kf.M,
         -K @ F,
         -K @ kf.M,
-        dt,
-        inputs=list(sensors),
-        outputs=list(controls),
-        name="lqg",
+        kf.Bu,
+        tuple(controls),
+        tuple(sensors),
+        float(dt),
+        "estimator",
+        source,
+        "prediction",
+    )
+
+
+def discrete_compensator(K, kf: KalmanFilter, dt: float, sensors, controls):
+    """Linear discrete LQG compensator (filter form) as a ``control.StateSpace``: the law of
+    :func:`estimator_law` without its use of the applied input (the black box from the sensors
+    to the commands, exact while no actuator limit is active)."""
+    import control
+
+    law = estimator_law(K, kf, controls, sensors, dt, "LQG")
+    return control.ss(
+        law.A, law.B, law.C, law.D, dt, inputs=list(sensors), outputs=list(controls), name="lqg"
     )
 
 

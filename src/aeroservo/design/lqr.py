@@ -17,6 +17,7 @@ from .._threads import blas_limited
 from ..errors import RANGES, InputError, check_number
 from ..linear.models import SAMPLE_RATES, check_continuous
 from ..linear.signals import check_names, check_signal_map, describe
+from .law import LinearLaw, pad_state_map, state_gain
 from .plant import SampledPlant, select
 
 BRYSON_RANGE = (RANGES["bryson"].lo, RANGES["bryson"].hi)
@@ -180,6 +181,11 @@ class StateFeedback:
     @property
     def gain_continuous(self) -> np.ndarray:
         return self.K @ self.state_map
+
+    def law(self, states) -> LinearLaw:
+        """``c = -Kd T x`` on a plant with the named ``states`` (filter states padded)."""
+        G = self.Kd @ pad_state_map(self.state_map, len(states))
+        return state_gain(G, self.controls, self.dt, source="LQR state feedback")
 
     # sampled-controller protocol used by the simulator
     def reset(self) -> None:

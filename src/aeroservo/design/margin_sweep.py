@@ -131,7 +131,9 @@ def margins_over_speed(
     v = np.asarray(speeds, dtype=float)
     out: list[LoopMargins] = []
     for s in v:  # loop_margins evaluates a schedule at the plant's speed
-        out.append(loop_margins(at(float(s)), controller, delay=delay, requirement=req))
+        out.append(
+            loop_margins(at(float(s)), controller, delay=delay, requirement=req, sensors=False)
+        )
 
         if progress is not None:
             progress(float(s))

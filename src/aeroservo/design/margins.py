@@ -1,29 +1,23 @@
-"""Loop margins at the actuator: broken-loop gain, phase and disk margins of the sampled loop.
+"""Loop margins of the sampled loop where the field breaks it (MIL-F-9490D, sec. 3.1.3.6).
 
-The loop of :mod:`aeroservo.design.sampled_loop` (plant, filters, estimator, delay) is broken
-at the input applied to the plant, one control channel at a time with the others closed. With
-``L(z)`` the return ratio of that channel (the loop closes as ``1 + L``), on the unit circle
-``z = exp(j w dt)`` from 0 to the Nyquist frequency:
+The loop of :mod:`aeroservo.design.sampled_loop` (plant, filters, controller, delay) is broken
 
-* **Nyquist criterion.** With ``P`` poles of the broken loop outside the unit circle (the
-  flutter modes above the open-loop flutter speed), the closed loop is stable iff ``1 + L``
-  winds ``P`` times counterclockwise around the origin over the whole circle. The winding is
-  counted on a frequency grid refined until the phase of ``1 + L`` moves by less than 0.2 rad
-  between neighbours, and compared with the eigenvalues of the loop matrix.
-* **Gain margins.** ``k L`` has a closed-loop pole on the unit circle where ``L`` is real and
-  negative, at ``k = -1 / L``; the stable interval of gains around ``k = 1`` is bounded by the
-  nearest such gains. An open-loop-unstable loop has a *gain-reduction* margin (< 0 dB) as well
-  as the usual increase margin.
-* **Phase margin.** Where ``|L| = 1``, the phase change ``exp(j phi)`` that puts a pole on the
-  circle; the margin is the smallest ``|phi|``.
-* **Disk margin** (balanced, Seiler, Packard and Gahinet 2020): ``alpha = 1 / max |S - 1/2|``
-  with ``S = 1 / (1 + L)``; the loop tolerates simultaneous gain changes within
-  ``[(2 - alpha) / (2 + alpha), (2 + alpha) / (2 - alpha)]`` and phase changes within
-  ``+-2 atan(alpha / 2)``.
+* **at each plant input** (the actuator command), one channel at a time with the others closed,
+  the controller a **black box** from sensors to commands: its estimator keeps predicting with
+  the command it computed, only the plant sees the perturbation (the default; the requirement
+  is judged here). ``measured_input=True`` models hardware that measures the input applied
+  (e.g. the hinge moment) and feeds it to the controller's estimator: then the perturbation
+  reaches the estimator too, and the margins are those of that hardware only;
+* **at each sensor** (the plant output), one at a time with the actuators closed (reported);
+* **at all plant inputs at once**: the simultaneous (multiloop) disk margin, independent
+  gain-phase variations in every channel (Seiler, Packard & Gahinet, "An introduction to disk
+  margins", IEEE Control Systems 40(5), 2020): ``alpha = 1 / max_w mu(S - I/2)``, with the
+  structured singular value bounded from above by D-scaling (slycot ``ab13md``), so the
+  reported ``alpha`` is a guaranteed (conservative) margin; exact with one input.
 
-(python-control's ``stability_margins`` overflows on loops of this order; this module uses the
-frequency response on a grid, roots refined by Brent's method.) Requirements default to
-MIL-F-9490D: 6 dB gain margin both ways and 45 deg phase margin.
+Each break point's gain, phase and disk margins come from :mod:`aeroservo.design.margin_channel`.
+The sensitivity ``S = (I + L)^-1`` and complementary sensitivity ``T = I - S`` at the plant
+input are kept over frequency (largest singular values) with their peaks.
 """
 
 from __future__ import annotations
@@ -33,159 +27,98 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.optimize as so
 
-from ..errors import InputError, check_number
+from ..errors import InputError
+from .law import delayed
+from .margin_channel import (
+    ChannelMargins,
+    MarginRequirement,
+    channel_margins,
+    frequency_response,
+)
 from .plant import SampledPlant
-from .sampled_loop import broken_loop, linear_law
+from .sampled_loop import LoopBlocks, linear_law, plant_states
 
-__all__ = ["MarginRequirement", "ChannelMargins", "LoopMargins", "loop_margins"]
+__all__ = ["MarginRequirement", "ChannelMargins", "LoopMargins", "loop_margins", "BREAK_POINTS"]
 
-PHASE_STEP = 0.2
-"""Largest change [rad] of the phase (and log-magnitude) of ``1 + L`` between grid points."""
-
-MAX_POINTS = 200_000
-"""Cap on the refined frequency grid."""
-
-
-@dataclass(frozen=True)
-class MarginRequirement:
-    """Stability-margin requirement at the actuator (controller file ``[margins]``).
-
-    Attributes
-    ----------
-    gain_db : float
-        Required gain margin, both ways [dB] (MIL-F-9490D: 6).
-    phase_deg : float
-        Required phase margin [deg] (MIL-F-9490D: 45).
-    disk_alpha : float or None
-        If set, the balanced disk margin ``alpha`` required instead of the gain and phase
-        margins (e.g. 0.67 tolerates +-6 dB and +-37 deg simultaneously).
-    """
-
-    gain_db: float = 6.0
-    phase_deg: float = 45.0
-    disk_alpha: float | None = None
-
-    def __post_init__(self) -> None:
-        check_number("margins.gain_db", self.gain_db, unit="dB", lo=0.0)
-        check_number("margins.phase_deg", self.phase_deg, unit="deg", lo=0.0, hi=180.0)
-        if self.disk_alpha is not None:
-            check_number("margins.disk_alpha", self.disk_alpha, lo=0.0, hi=2.0, lo_open=True)
-
-
-@dataclass
-class ChannelMargins:
-    """Margins of one control channel (the other channels closed); frequencies in Hz.
-
-    Attributes
-    ----------
-    control : str
-    stable : bool
-        Closed loop stable (eigenvalues of the loop matrix).
-    nyquist_stable : bool
-        Stable by the Nyquist criterion (the winding equals ``open_loop_unstable``).
-    open_loop_unstable : int
-        Poles of the broken loop outside the unit circle.
-    encirclements : float
-        Counterclockwise encirclements of -1 by ``L`` over the unit circle.
-    gain_margin_db, gain_reduction_margin_db : float
-        Gain increase (>= 0, inf if none) and reduction (<= 0, -inf if none) margins [dB].
-    gain_frequencies : tuple
-        Frequencies [Hz] of the two critical gains (None where there is none).
-    phase_margin_deg : float
-        [deg] (inf if ``|L|`` never crosses 1), at ``phase_frequency`` [Hz].
-    disk_margin : float
-        Balanced disk margin ``alpha`` (0 if the closed loop is unstable), at
-        ``disk_frequency`` [Hz]; ``disk_gain_margin_db`` and ``disk_phase_margin_deg`` are the
-        simultaneous gain and phase variations it tolerates.
-    omega : ndarray
-        Refined grid [rad/s] from 0 to the Nyquist frequency; ``response`` is ``L`` on it.
-    """
-
-    control: str
-    stable: bool
-    nyquist_stable: bool
-    open_loop_unstable: int
-    encirclements: float
-    gain_margin_db: float
-    gain_reduction_margin_db: float
-    gain_frequencies: tuple
-    phase_margin_deg: float
-    phase_frequency: float | None
-    disk_margin: float
-    disk_gain_margin_db: float
-    disk_phase_margin_deg: float
-    disk_frequency: float | None
-    omega: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
-    response: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
-
-    def violations(self, req: MarginRequirement) -> list[str]:
-        """What this channel misses of ``req`` (empty: it meets it)."""
-        if not self.stable:
-            return [f"{self.control}: closed loop unstable"]
-        out = []
-        if req.disk_alpha is not None:
-            if self.disk_margin < req.disk_alpha:
-                out.append(f"{self.control}: disk margin {self.disk_margin:.3g} < {req.disk_alpha}")
-            return out
-        if self.gain_margin_db < req.gain_db:
-            out.append(f"{self.control}: gain margin {self.gain_margin_db:.3g} dB < {req.gain_db}")
-        if self.gain_reduction_margin_db > -req.gain_db:
-            out.append(
-                f"{self.control}: gain-reduction margin {self.gain_reduction_margin_db:.3g} dB "
-                f"> -{req.gain_db}"
-            )
-        if self.phase_margin_deg < req.phase_deg:
-            out.append(
-                f"{self.control}: phase margin {self.phase_margin_deg:.3g} deg < {req.phase_deg}"
-            )
-        return out
-
-    def to_dict(self) -> dict:
-        """JSON-ready (dB, deg, Hz; infinite margins as null)."""
-
-        def fin(x):
-            return None if x is None or not np.isfinite(x) else float(x)
-
-        return {
-            "stable": self.stable,
-            "nyquist_stable": self.nyquist_stable,
-            "open_loop_unstable_poles": self.open_loop_unstable,
-            "encirclements": float(self.encirclements),
-            "gain_margin_db": fin(self.gain_margin_db),
-            "gain_reduction_margin_db": fin(self.gain_reduction_margin_db),
-            "gain_frequencies": [fin(f) for f in self.gain_frequencies],
-            "phase_margin_deg": fin(self.phase_margin_deg),
-            "phase_frequency": fin(self.phase_frequency),
-            "disk_margin": fin(self.disk_margin),
-            "disk_gain_margin_db": fin(self.disk_gain_margin_db),
-            "disk_phase_margin_deg": fin(self.disk_phase_margin_deg),
-            "disk_frequency": fin(self.disk_frequency),
-        }
+BREAK_POINTS = {
+    "black_box": "plant input (actuator command), controller a black box from sensors to commands",
+    "measured": "plant input (actuator), the applied input measured and fed to the controller's "
+    "estimator",
+    "sensors": "plant output (each sensor), actuators closed",
+    "multiloop": "all plant inputs at once (simultaneous disk margin), controller a black box",
+}
+"""Where each figure of :class:`LoopMargins` breaks the loop (as written in reports)."""
 
 
 @dataclass
 class LoopMargins:
-    """Margins of every control channel of a sampled loop at one speed."""
+    """Margins of a sampled loop at one speed (frequencies in Hz, gains in dB, phases in deg).
+
+    Attributes
+    ----------
+    channels : dict
+        ``{control: ChannelMargins}`` at each plant input (loop at a time): the requirement is
+        judged on these.
+    sensors : dict
+        ``{sensor: ChannelMargins}`` at each sensor (empty for state feedback).
+    multiloop : dict
+        Simultaneous disk margin at all inputs: ``disk_margin``, ``disk_gain_margin_db``,
+        ``disk_phase_margin_deg``, ``frequency`` [Hz], ``method``.
+    sensitivity : dict
+        ``omega`` [rad/s], ``S`` and ``T`` (largest singular values at the plant input),
+        ``peak_S``, ``peak_T`` and their frequencies [Hz].
+    speed, dt : float
+        [m/s], [s]
+    delay : bool
+    requirement : MarginRequirement
+    measured_input : bool
+        Whether the input break point feeds the applied input to the estimator.
+    law : str
+        What the controller's linear law is (e.g. an MPC's law without active constraints).
+    """
 
     channels: dict
     speed: float
     dt: float
     delay: bool
     requirement: MarginRequirement = field(default_factory=MarginRequirement)
+    sensors: dict = field(default_factory=dict)
+    multiloop: dict = field(default_factory=dict)
+    sensitivity: dict = field(default_factory=dict, repr=False)
+    measured_input: bool = False
+    law: str = ""
+
+    @property
+    def break_point(self) -> str:
+        """Where :attr:`channels` break the loop."""
+        return BREAK_POINTS["measured" if self.measured_input else "black_box"]
 
     def violations(self) -> list[str]:
-        return [v for ch in self.channels.values() for v in ch.violations(self.requirement)]
+        """What the loop misses of :attr:`requirement` at its inputs (empty: it meets it)."""
+        out = [v for ch in self.channels.values() for v in ch.violations(self.requirement)]
+        alpha = self.requirement.disk_alpha
+        disk = self.multiloop.get("disk_margin")
+        if alpha is not None and not out and disk is not None and disk < alpha:
+            out.append(f"simultaneous disk margin {disk:.3g} < {alpha}")
+        return out
 
     @property
     def meets(self) -> bool:
-        """Whether every channel meets :attr:`requirement`."""
+        """Whether every input channel meets :attr:`requirement`."""
         return not self.violations()
 
     def to_dict(self) -> dict:
+        """JSON-ready: every figure with the break point it belongs to."""
         r = self.requirement
+
+        def fin(x):
+            return None if x is None or not np.isfinite(x) else float(x)
+
+        sens = self.sensitivity
         return {
             "speed": self.speed,
             "delay": self.delay,
+            "law": self.law,
             "requirement": {
                 "gain_db": r.gain_db,
                 "phase_deg": r.phase_deg,
@@ -193,149 +126,85 @@ class LoopMargins:
             },
             "meets": self.meets,
             "violations": self.violations(),
+            "break_point": self.break_point,
+            "measured_input": self.measured_input,
             "channels": {c: m.to_dict() for c, m in self.channels.items()},
+            "sensors_break_point": BREAK_POINTS["sensors"],
+            "sensors": {s: m.to_dict() for s, m in self.sensors.items()},
+            "multiloop_break_point": BREAK_POINTS["multiloop"],
+            "multiloop": {
+                k: (fin(v) if not isinstance(v, str) else v) for k, v in self.multiloop.items()
+            },
+            "peak_sensitivity": fin(sens.get("peak_S")),
+            "peak_sensitivity_frequency": fin(sens.get("peak_S_frequency")),
+            "peak_complementary_sensitivity": fin(sens.get("peak_T")),
+            "peak_complementary_sensitivity_frequency": fin(sens.get("peak_T_frequency")),
         }
 
 
-def _response(A: np.ndarray, B: np.ndarray, C: np.ndarray):
-    """``theta -> L(exp(j theta)) = -C (zI - A)^-1 B`` (SISO), by a verified eigen-expansion
-    (linear in the grid size) or, for a badly conditioned eigenbasis, by direct solves."""
-    n = A.shape[0]
-    b, c = B[:, 0], C[0]
-
-    def direct(theta: np.ndarray) -> np.ndarray:
-        out = np.empty(theta.size, dtype=complex)
-        eye = np.eye(n)
-        for k, z in enumerate(np.exp(1j * theta)):
-            out[k] = -c @ np.linalg.solve(z * eye - A, b)
-        return out
-
-    lam, V = np.linalg.eig(A)
-    try:
-        bv = np.linalg.solve(V, b)
-    except np.linalg.LinAlgError:
-        return direct
-    cv = c @ V
-    r = cv * bv
-
-    def modal(theta: np.ndarray) -> np.ndarray:
-        z = np.exp(1j * np.asarray(theta, dtype=float))
-        return -(1.0 / (z[:, None] - lam[None, :])) @ r
-
-    probe = np.linspace(0.0, np.pi, 9)[1:-1] + 0.01
-    ref = direct(probe)
-    if np.all(np.abs(modal(probe) - ref) <= 1e-9 * (1.0 + np.abs(ref))):
-        return modal
-    return direct
+def _disk(alpha: float) -> tuple[float, float]:
+    """Simultaneous gain [dB] and phase [deg] variations of a balanced disk of size alpha."""
+    gm = 20 * np.log10((2 + alpha) / (2 - alpha)) if alpha < 2 else np.inf
+    return float(gm), float(np.degrees(2 * np.arctan(alpha / 2))) if alpha > 0 else 0.0
 
 
-def _grid(L, poles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Refined grid on [0, pi] and ``L`` on it: log-spaced, dense near the poles, then bisected
-    until the phase and log-magnitude of ``1 + L`` change by less than :data:`PHASE_STEP`."""
-    th = [np.pi * np.geomspace(1e-6, 1.0, 1500), [0.0, np.pi]]
-    for p in poles:
-        ang, d = abs(np.angle(p)), max(abs(1.0 - abs(p)), 1e-7)
-        if abs(p) > 0.2:
-            th.append(ang + d * np.linspace(-8.0, 8.0, 33))
-    theta = np.unique(np.clip(np.concatenate(th), 0.0, np.pi))
-    vals = L(theta)
-    for _ in range(40):
-        f = 1.0 + vals
-        step = np.abs(np.angle(f[1:] / f[:-1])) + np.abs(np.log(np.abs(f[1:] / f[:-1])))
-        bad = np.flatnonzero((step > PHASE_STEP) & (np.diff(theta) > 1e-13))
-        if bad.size == 0 or theta.size > MAX_POINTS:
-            break
-        mid = 0.5 * (theta[bad] + theta[bad + 1])
-        theta = np.concatenate([theta, mid])
-        vals = np.concatenate([vals, L(mid)])
-        order = np.argsort(theta)
-        theta, vals = theta[order], vals[order]
-    return theta, vals
+def _multiloop(A, B, C, theta: np.ndarray, dt: float, channels: dict) -> tuple[dict, dict]:
+    """Simultaneous disk margin at all inputs and the input sensitivities on ``theta``."""
+    m = B.shape[1]
+    F = frequency_response(A, B, C)
+    eye = np.eye(m)
 
+    def S_of(th):
+        return np.linalg.inv(eye[None] + F(th))
 
-def _roots(fun, theta: np.ndarray, values: np.ndarray) -> list[float]:
-    """Roots of a real function of theta bracketed by sign changes on the grid (Brent)."""
-    idx = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
-    return [so.brentq(fun, theta[i], theta[i + 1], xtol=1e-14) for i in idx]
-
-
-def _channel(A, B, C, control: str, dt: float) -> ChannelMargins:
-    """Margins of the SISO loop ``1 + L``, ``L = -C (zI - A)^-1 B``."""
-    L = _response(A, B, C)
-    poles = np.linalg.eigvals(A)
-    closed = np.linalg.eigvals(A + B @ C)
-    stable = bool(np.max(np.abs(closed)) < 1.0)
-    n_unstable = int(np.sum(np.abs(poles) > 1.0))
-    theta, vals = _grid(L, np.concatenate([poles, closed]))
-    f = 1.0 + vals
-    winding = float(np.sum(np.angle(f[1:] / f[:-1])) / np.pi)
-    nyquist_stable = bool(abs(winding - n_unstable) < 0.25)
+    S = S_of(theta)
+    T = eye[None] - S
+    sS = np.linalg.svd(S, compute_uv=False)[:, 0]
+    sT = np.linalg.svd(T, compute_uv=False)[:, 0]
     hz = 1.0 / (2 * np.pi * dt)
+    sens = {
+        "omega": theta / dt,
+        "S": sS,
+        "T": sT,
+        "peak_S": float(sS.max()),
+        "peak_S_frequency": float(theta[int(np.argmax(sS))] * hz),
+        "peak_T": float(sT.max()),
+        "peak_T_frequency": float(theta[int(np.argmax(sT))] * hz),
+    }
+    stable = bool(np.max(np.abs(np.linalg.eigvals(A + B @ C))) < 1.0)
+    if m == 1:
+        ch = next(iter(channels.values()))
+        alpha, f, method = ch.disk_margin, ch.disk_frequency, "exact (one input)"
+    elif not stable:
+        alpha, f, method = 0.0, None, "closed loop unstable"
+    else:
+        from slycot import ab13md
 
-    # critical gains: L real and negative (endpoints 0 and pi are real by symmetry)
-    cand = _roots(lambda t: float(L(np.array([t]))[0].imag), theta, vals.imag)
-    ends = [t for t in cand + [0.0, np.pi]]
-    real = L(np.array(ends)).real
-    ks = [(-1.0 / r, t) for r, t in zip(real, ends, strict=True) if r < 0]
-    up = [(k, t) for k, t in ks if k > 1.0]
-    down = [(k, t) for k, t in ks if 0.0 < k < 1.0]
-    k_up = min(up, default=(np.inf, None))
-    k_dn = max(down, default=(0.0, None))
-    gm_up = 20 * np.log10(k_up[0]) if np.isfinite(k_up[0]) else np.inf
-    gm_dn = 20 * np.log10(k_dn[0]) if k_dn[0] > 0 else -np.inf
+        blocks, kinds = np.ones(m, dtype=int), 2 * np.ones(m, dtype=int)
 
-    # phase margin: |L| = 1
-    lm = np.log(np.maximum(np.abs(vals), 1e-300))
-    cross = _roots(lambda t: float(np.log(abs(L(np.array([t]))[0]))), theta, lm)
-    pm, pm_t = np.inf, None
-    for t in cross:
-        phi = float(np.degrees(abs(np.angle(-1.0 / L(np.array([t]))[0]))))
-        if phi < pm:
-            pm, pm_t = phi, t
+        def mu(th):
+            M = S_of(np.array([th]))[0] - 0.5 * eye
+            return float(ab13md(np.asarray(M, dtype=complex), blocks, kinds)[0])
 
-    # balanced disk margin
-    alpha, disk_t = 0.0, None
-    if stable:
-        dist = np.abs((1.0 - vals) / (2.0 * f))
-        i = int(np.argmax(dist))
+        vals = np.array([mu(t) for t in theta])
+        i = int(np.argmax(vals))
+        peak, t_peak = vals[i], theta[i]
         lo, hi = theta[max(i - 1, 0)], theta[min(i + 1, theta.size - 1)]
-
-        def neg(t):
-            v = L(np.array([t]))[0]
-            return -abs((1.0 - v) / (2.0 * (1.0 + v)))
-
-        peak, disk_t = dist[i], theta[i]
         if hi > lo:
-            res = so.minimize_scalar(
-                neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-13}
-            )
+            res = so.minimize_scalar(lambda t: -mu(t), bounds=(lo, hi), method="bounded")
             if -res.fun > peak:
-                peak, disk_t = -res.fun, float(res.x)
-        alpha = float(1.0 / peak)
-    disk_gm = 20 * np.log10((2 + alpha) / (2 - alpha)) if alpha < 2 else np.inf
-    disk_pm = float(np.degrees(2 * np.arctan(alpha / 2))) if alpha > 0 else 0.0
-
-    def freq(t):
-        return None if t is None else float(t * hz)
-
-    return ChannelMargins(
-        control=control,
-        stable=stable,
-        nyquist_stable=nyquist_stable,
-        open_loop_unstable=n_unstable,
-        encirclements=winding,
-        gain_margin_db=float(gm_up),
-        gain_reduction_margin_db=float(gm_dn),
-        gain_frequencies=(freq(k_dn[1]), freq(k_up[1])),
-        phase_margin_deg=pm,
-        phase_frequency=freq(pm_t),
-        disk_margin=alpha,
-        disk_gain_margin_db=float(disk_gm),
-        disk_phase_margin_deg=disk_pm,
-        disk_frequency=freq(disk_t),
-        omega=theta / dt,
-        response=vals,
-    )
+                peak, t_peak = -res.fun, float(res.x)
+        alpha, f = float(1.0 / peak), float(t_peak * hz)
+        method = "mu upper bound by D-scaling (slycot ab13md): a guaranteed margin"
+    gm, pm = _disk(alpha)
+    multi = {
+        "disk_margin": alpha,
+        "disk_gain_margin_db": gm,
+        "disk_phase_margin_deg": pm,
+        "frequency": f,
+        "method": method,
+    }
+    return multi, sens
 
 
 def loop_margins(
@@ -344,36 +213,69 @@ def loop_margins(
     *,
     delay: bool = False,
     requirement: MarginRequirement | None = None,
+    measured_input: bool = False,
+    sensors: bool = True,
+    sample_rate: float | None = None,
 ) -> LoopMargins:
-    """Broken-loop margins at each control input of the sampled loop.
+    """Margins of the sampled loop at each plant input, each sensor and all inputs at once.
 
     Parameters
     ----------
     plant : control.StateSpace
         Continuous plant (filters included) with the controller's controls and sensors.
     controller
-        A linear sampled controller (state feedback, LQG, H-infinity compensator, or an MPC as
-        its unconstrained law; a schedule is evaluated at the plant's speed).
+        A linear controller (:func:`aeroservo.design.as_controller`; a schedule is evaluated
+        at the plant's speed, an MPC by its law without active constraints). A Python law is
+        refused.
     delay : bool
         One-sample computational delay.
     requirement : MarginRequirement, optional
-        Default MIL-F-9490D (6 dB, 45 deg).
+        Default MIL-F-9490D (6 dB both ways, 45 deg), judged at the plant inputs.
+    measured_input : bool
+        False (default): the controller is a black box from sensors to commands; True: the
+        applied input is measured and fed to its estimator (see the module docstring).
+    sensors : bool
+        Also break the loop at each sensor.
+    sample_rate : float, optional
+        [Hz] for a continuous python-control compensator.
 
     Returns
     -------
     LoopMargins
     """
+    from .closed_loop import linear_controller
+
     speed = float(getattr(plant, "speed", np.nan))
-    if hasattr(controller, "at"):
-        controller = controller.at(speed)
-    law = linear_law(controller, plant.nstates)
-    if law.kind == "state" and not np.any(law.G):
+    ctrl = linear_controller(controller, "loop_margins", sample_rate)
+    if hasattr(ctrl, "at"):
+        ctrl = ctrl.at(speed)
+    law = linear_law(ctrl, plant_states(plant))
+    if not law.has_feedback:
         raise InputError("loop_margins: the controller has no feedback (open loop)")
+    law = delayed(law) if delay else law
     sp = SampledPlant.from_statespace(plant, law.dt, list(law.controls), (), list(law.sensors))
-    A, B, C = broken_loop(sp, law, delay)
+    blocks = LoopBlocks(sp, law, bool(measured_input))
+    A, B, C = blocks.at_inputs()
     channels = {}
     for j, name in enumerate(law.controls):
         others = [i for i in range(len(law.controls)) if i != j]
         Aj = A + B[:, others] @ C[others] if others else A
-        channels[name] = _channel(Aj, B[:, [j]], C[[j]], name, law.dt)
-    return LoopMargins(channels, speed, law.dt, bool(delay), requirement or MarginRequirement())
+        channels[name] = channel_margins(Aj, B[:, [j]], C[[j]], name, law.dt)
+    at_sensors = {}
+    if sensors:
+        for j, name in enumerate(law.sensors):
+            at_sensors[name] = channel_margins(*blocks.at_sensor(j), name, law.dt)
+    theta = np.unique(np.concatenate([ch.omega * law.dt for ch in channels.values()]))
+    multi, sens = _multiloop(A, B, C, theta, law.dt, channels)
+    return LoopMargins(
+        channels,
+        speed,
+        law.dt,
+        bool(delay),
+        requirement or MarginRequirement(),
+        sensors=at_sensors,
+        multiloop=multi,
+        sensitivity=sens,
+        measured_input=bool(measured_input),
+        law=law.source,
+    )

@@ -26,9 +26,11 @@ import numpy as np
 from .._c_stdout import c_stdout_silenced
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number, check_quantity
-from .lqg import KalmanFilter, kalman_filter, solve_dare
+from .law import LinearLaw
+from .lqg import KalmanFilter, estimator_law, kalman_filter
 from .lqr import Bryson, cost_weights
 from .plant import Limits, SampledPlant, select
+from .riccati import solve_dare
 
 __all__ = ["MPCController", "mpc", "SOLVERS"]
 
@@ -200,6 +202,18 @@ class MPCController:
     def update(self, y: np.ndarray, u: np.ndarray) -> None:
         self.kf.predict(u)
 
+    def law(self, states=()) -> LinearLaw:
+        """Its law without active constraints: the LQG whose gain is the first move of the
+        unconstrained QP (what the linear analyses of an MPC loop use)."""
+        return estimator_law(
+            self.unconstrained_gain(),
+            self.kf,
+            self.controls,
+            self.sensors,
+            self.dt,
+            "MPC without active constraints (its LQG)",
+        )
+
     def unconstrained_gain(self) -> np.ndarray:
         """Gain ``K`` with ``c = -K xi+`` of the MPC without active constraints (its first move
         as a linear function of the estimate: the MPC's loop as an LQG)."""
@@ -244,6 +258,7 @@ def mpc(
     limits: Limits,
     process_noise: dict,
     sensor_noise: dict,
+    input_noise: dict | None = None,
     horizon: int = 20,
     bryson: Bryson | None = None,
     Q: np.ndarray | None = None,
@@ -265,6 +280,8 @@ def mpc(
         Hard magnitude and rate limits of every control (both are required).
     process_noise, sensor_noise : dict
         Kalman filter noise variances (see :func:`aeroservo.design.lqg.kalman_filter`).
+    input_noise : dict, optional
+        Loop transfer recovery at the plant input (:func:`aeroservo.design.lqg.kalman_filter`).
     horizon : int
         Prediction horizon N [samples].
     bryson, Q, R :
@@ -298,7 +315,7 @@ def mpc(
     n, m = B.shape
     Q, R, Ncross = cost_weights(sys, controls, Q, R, bryson, "mpc")
     sp = SampledPlant.from_statespace(sys, dt, controls, tuple(process_noise), list(sensors))
-    kf = kalman_filter(sp, sensors, process_noise, sensor_noise)
+    kf = kalman_filter(sp, sensors, process_noise, sensor_noise, input_noise)
     Qd, Rd, Nd = Q * dt, R * dt, Ncross * dt
     # terminal cost: DARE with the cross term removed by a change of input
     Rinv_Nt = np.linalg.solve(Rd, Nd.T)

@@ -22,6 +22,7 @@ import scipy.linalg as sla
 from ..errors import RANGES, InputError, check_number
 from ..linear.models import check_continuous
 from ..linear.signals import check_names, check_signal_map, describe
+from .law import LinearLaw, state_gain
 
 MAX_CUTOFF = RANGES["frequency"].hi
 """Largest anti-aliasing filter cutoff [Hz]."""
@@ -262,6 +263,11 @@ class OpenLoop:
     dt: float
     sensors: tuple = ()
     needs_state: bool = False
+
+    def law(self, states) -> LinearLaw:
+        """No feedback: ``c = 0``."""
+        zero = np.zeros((len(self.controls), len(states)))
+        return state_gain(zero, self.controls, self.dt, kind="open", source="open loop")
 
     def reset(self) -> None:
         pass

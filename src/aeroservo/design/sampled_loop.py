@@ -1,165 +1,135 @@
 """One description of the sampled loop, shared by the loop matrix, the closed-loop boundary, the
-loop margins and (through the same step equations) the time march.
+loop margins and the time march.
 
 At sample k, with the plant sampled by zero-order hold (:mod:`aeroservo.design.plant`):
 
-* the sensors are read: ``y_k = C x_k + Du h_k`` (``h_k = u_{k-1}``, the input held over the
-  last interval);
-* the controller computes a command ``c_k``: state feedback ``c_k = -G x_k``; an estimator-based
-  law (LQG, MPC without active constraints, its Kalman filter ``xi``)
-  ``xi+ = xi- + M (y_k - Ca xi-)``, ``c_k = -K xi+``; or a discrete compensator (H-infinity)
-  ``c_k = Cc s_k + Dc y_k``, ``s_{k+1} = Ac s_k + Bc y_k``;
-* the input applied is ``u_k = c_k``, or ``u_k = p_k`` (the command computed one sample
-  earlier) with a computational delay, then limited (rate, then magnitude);
-* ``x_{k+1} = Phi x_k + Gu u_k``, ``h_{k+1} = u_k``, ``p_{k+1} = c_k`` and the estimator
-  predicts with the input *applied*: ``xi-_{k+1} = Ad xi+ + Bu u_k``.
+* the controller measures ``m_k``: the sensors ``C x_k + Du h_k`` (``h_k = u_{k-1}``, the input
+  held over the last interval) or, for state feedback, the plant state ``x_k``;
+* it emits the command ``c_k = C s_k + D m_k`` and updates its state
+  ``s_{k+1} = A s_k + B m_k + L (u_k - c_k)`` (:class:`~aeroservo.design.law.LinearLaw`; a
+  computational delay is part of the law, :func:`~aeroservo.design.law.delayed`);
+* the input applied is ``u_k = c_k`` limited (rate, then magnitude);
+* ``x_{k+1} = Phi x_k + Gu u_k`` and ``h_{k+1} = u_k``.
 
-:func:`simulate` marches exactly these equations (with the limits); :func:`loop_matrix` is
-their linear part (limits inactive), the transition of the loop state ``[x, h, p, xi-, s]``.
-Before this module the loop matrix let an LQG predict with its own command while the simulator
-predicted with the delayed one, so the two disagreed with a delay.
+:func:`aeroservo.simulate.simulate` marches exactly these equations (with the limits);
+:func:`loop_matrix` is their linear part (limits inactive), the transition of the loop state
+``[x, h, s]``. The loop is broken where the field breaks it (:func:`broken_loop`): at each
+plant input (the actuator), the controller a black box from sensors to commands, so only the
+plant sees the perturbation (``u_k - c_k`` is known to the controller's software and is not
+perturbed; ``measured_input=True`` models hardware that measures the applied input instead), or
+at each sensor (the plant output).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
 from ..errors import InputError
+from ..linear.signals import describe
+from .law import LinearLaw, delayed
 from .plant import SampledPlant
 
-__all__ = ["LinearLaw", "linear_law", "loop_matrix", "broken_loop"]
+__all__ = ["linear_law", "loop_matrix", "broken_loop", "plant_states", "LoopBlocks"]
 
 
-@dataclass
-class LinearLaw:
-    """A linear sampled controller as matrices (see the module docstring).
-
-    Attributes
-    ----------
-    kind : str
-        ``"state"`` (``c = -G x``), ``"estimator"`` (``c = -K xi+``) or ``"compensator"``.
-    controls, sensors : tuple of str
-    dt : float
-        Sample period [s].
-    G : ndarray or None
-        State-feedback gain on the plant state.
-    K, Ad, Bu, Ca, M : ndarray or None
-        Estimator law.
-    Ac, Bc, Cc, Dc : ndarray or None
-        Discrete compensator from the sensors to the commands.
-    """
-
-    kind: str
-    controls: tuple
-    sensors: tuple
-    dt: float
-    G: np.ndarray | None = None
-    K: np.ndarray | None = None
-    Ad: np.ndarray | None = None
-    Bu: np.ndarray | None = None
-    Ca: np.ndarray | None = None
-    M: np.ndarray | None = None
-    Ac: np.ndarray | None = None
-    Bc: np.ndarray | None = None
-    Cc: np.ndarray | None = None
-    Dc: np.ndarray | None = None
-
-    @property
-    def n_states(self) -> int:
-        if self.kind == "estimator":
-            return self.Ad.shape[0]
-        if self.kind == "compensator":
-            return self.Ac.shape[0]
-        return 0
+def plant_states(plant) -> tuple[str, ...]:
+    """The state names of a plant (a ``control.StateSpace`` or anything with ``state_labels``)."""
+    labels = getattr(plant, "state_labels", None)
+    if labels is None:
+        raise InputError(f"plant = {describe(plant)}: expected a control.StateSpace")
+    return tuple(labels)
 
 
-def _pad(T: np.ndarray, n_plant: int) -> np.ndarray:
-    """State map padded with zero columns for plant states appended after the model's own
-    (e.g. sensor filters of :func:`~aeroservo.design.plant.with_sensor_filters`)."""
-    if T.shape[1] > n_plant:
-        raise InputError(
-            f"state feedback: the gain needs {T.shape[1]} plant states, the plant has {n_plant}"
-        )
-    return np.hstack([T, np.zeros((T.shape[0], n_plant - T.shape[1]))])
-
-
-def linear_law(controller, n_plant: int) -> LinearLaw:
-    """The linear law of a sampled controller.
+def linear_law(controller, states: Sequence[str]) -> LinearLaw:
+    """The linear law of a sampled controller around a plant with the named ``states``.
 
     Parameters
     ----------
-    controller : StateFeedback, OutputFeedback, MPCController, DiscreteCompensator or OpenLoop
-        An MPC controller gives its law without active constraints (the LQG whose gain is the
-        first move of the unconstrained QP).
-    n_plant : int
-        States of the plant the loop is closed around (filters included).
+    controller
+        A controller of :mod:`aeroservo.design` (see :func:`aeroservo.design.as_controller`);
+        an MPC gives its law without active constraints (the LQG whose gain is the first move
+        of its unconstrained QP); a schedule must be evaluated at a speed first (``at``).
+    states : sequence of str
+        The plant's state names (filters included), for state feedback on named states.
+
+    Raises
+    ------
+    InputError
+        If the controller has no linear law (a Python law, or an unknown object).
     """
-    controls = tuple(controller.controls)
-    sensors = tuple(getattr(controller, "sensors", ()))
-    dt = float(controller.dt)
-    if getattr(controller, "needs_state", False):
-        G = controller.Kd @ _pad(controller.state_map, n_plant)
-        return LinearLaw("state", controls, (), dt, G=G)
-    if hasattr(controller, "compensator_matrices"):
-        Ac, Bc, Cc, Dc = controller.compensator_matrices()
-        return LinearLaw("compensator", controls, sensors, dt, Ac=Ac, Bc=Bc, Cc=Cc, Dc=Dc)
-    kf = getattr(controller, "kf", None)
-    if kf is None:  # open loop: no command
-        return LinearLaw("state", controls, (), dt, G=np.zeros((len(controls), n_plant)))
-    K = controller.unconstrained_gain() if hasattr(controller, "unconstrained_gain") else None
-    K = controller.K if K is None else K
-    return LinearLaw("estimator", controls, sensors, dt, K=K, Ad=kf.Ad, Bu=kf.Bu, Ca=kf.Ca, M=kf.M)
+    law = getattr(controller, "law", None)
+    if not callable(law):
+        raise InputError(
+            f"controller = {describe(controller)}: not a linear controller, so it has no "
+            "closed-loop eigenvalues or margins; simulate it, or bring its matrices "
+            "(aeroservo.design.as_controller(control.ss(A, B, C, D, dt)))"
+        )
+    return law(tuple(states))
 
 
-def _blocks(sp: SampledPlant, law: LinearLaw, delay: bool):
-    """Transition of the loop state with the loop broken at the plant input.
+class LoopBlocks:
+    """The sampled loop with both break points open (see the module docstring).
 
-    Returns ``(A0, Bw, Cc, Dc, sizes)``: with ``w_k`` the input applied to the plant,
-    ``state_{k+1} = A0 state_k + Bw w_k`` and the command ``c_k = Cc state_k + Dc w_k``...
-    For the estimator law ``c_k`` does not depend on ``w_k`` (``Dc = 0``): the sensors see
-    the held input, not the new one.
+    With ``w`` the input applied to the plant and ``v`` the measurement the controller reads,
+    the loop state ``z = [x, h, s]`` obeys ``z+ = Az z + Bw w + Bv v``; the controller emits
+    ``o = Co z + Dv v`` and the true measurement is ``m = Cm z``. The closed loop is
+    ``w = o, v = m``.
     """
-    n, m = sp.Gu.shape
-    ne = law.n_states
-    n_h = m if law.kind != "state" else 0  # the held input only matters through the sensors
-    n_p = m if delay else 0
-    N = n + n_h + n_p + ne
-    ix, ih = slice(0, n), slice(n, n + n_h)
-    ip, ie = slice(n + n_h, n + n_h + n_p), slice(n + n_h + n_p, N)
-    A = np.zeros((N, N))
-    Bw = np.zeros((N, m))
-    Cc = np.zeros((m, N))  # the command c_k from the state
-    A[ix, ix] = sp.Phi
-    Bw[ix] = sp.Gu
-    if n_h:
-        Bw[ih] = np.eye(m)
-    if law.kind == "state":
-        Cc[:, ix] = -law.G
-    else:
-        Cy = np.zeros((len(law.sensors), N))  # y_k from the state
-        Cy[:, ix] = sp.C
-        Cy[:, ih] = sp.Du
-        if law.kind == "estimator":
-            F = np.eye(ne) - law.M @ law.Ca
-            post = np.zeros((ne, N))  # xi+ from the state
-            post[:, ie] = F
-            post += law.M @ Cy
-            Cc = -law.K @ post
-            A[ie] = law.Ad @ post
-            Bw[ie] = law.Bu
+
+    def __init__(self, sp: SampledPlant, law: LinearLaw, measured_input: bool = False):
+        n, m = sp.Gu.shape
+        ns = law.n_states
+        n_h = 0 if law.state_feedback else m  # the held input is seen through the sensors only
+        N = n + n_h + ns
+        ix, ih, ic = slice(0, n), slice(n, n + n_h), slice(n + n_h, N)
+        if law.state_feedback:
+            if law.D.shape[1] != n:
+                raise InputError(
+                    f"state feedback on {law.D.shape[1]} states; the plant has {n} states"
+                )
+            Cm = np.zeros((n, N))
+            Cm[:, ix] = np.eye(n)
         else:
-            Cc[:, ie] = law.Cc
-            Cc += law.Dc @ Cy
-            A[ie, ie] = law.Ac
-            A[ie] += law.Bc @ Cy
-    if n_p:
-        A[ip] = Cc
-        out = np.zeros((m, N))  # with a delay the input applied is the pending command
-        out[:, ip] = np.eye(m)
-        return A, Bw, out, {"n_x": n, "n_h": n_h, "n_p": n_p, "n_e": ne}
-    return A, Bw, Cc, {"n_x": n, "n_h": n_h, "n_p": n_p, "n_e": ne}
+            Cm = np.zeros((len(law.sensors), N))
+            Cm[:, ix] = sp.C
+            Cm[:, ih] = sp.Du
+        Lm = law.L if measured_input else np.zeros_like(law.L)
+        Az = np.zeros((N, N))
+        Bw = np.zeros((N, m))
+        Bv = np.zeros((N, Cm.shape[0]))
+        Co = np.zeros((m, N))
+        Az[ix, ix] = sp.Phi
+        Bw[ix] = sp.Gu
+        if n_h:
+            Bw[ih] = np.eye(m)
+        Az[ic, ic] = law.A - Lm @ law.C
+        Bv[ic] = law.B - Lm @ law.D
+        Bw[ic] = Lm
+        Co[:, ic] = law.C
+        self.Az, self.Bw, self.Bv, self.Co, self.Dv, self.Cm = Az, Bw, Bv, Co, law.D, Cm
+        self.sizes = {"n_x": n, "n_h": n_h, "n_s": ns}
+
+    def closed(self) -> np.ndarray:
+        """Transition matrix of the closed loop."""
+        Co = self.Co + self.Dv @ self.Cm
+        return self.Az + self.Bw @ Co + self.Bv @ self.Cm
+
+    def at_inputs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C)`` broken at every plant input (sensors closed): ``z+ = A z + B w``,
+        ``o = C z``; return ratio ``L = -o / w``."""
+        return self.Az + self.Bv @ self.Cm, self.Bw, self.Co + self.Dv @ self.Cm
+
+    def at_sensor(self, j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C)`` broken at measurement ``j`` (inputs and other sensors closed): the
+        controller reads ``v`` for it, the loop gives back the true value ``r = C z``; return
+        ratio ``L = -r / v``."""
+        P = np.eye(self.Cm.shape[0])
+        P[j, j] = 0.0
+        Gv = self.Bw @ self.Dv + self.Bv
+        A = self.Az + self.Bw @ self.Co + Gv @ P @ self.Cm
+        return A, Gv[:, [j]], self.Cm[[j]]
 
 
 def loop_matrix(sp: SampledPlant, law: LinearLaw, delay: bool = False) -> np.ndarray:
@@ -174,14 +144,15 @@ def loop_matrix(sp: SampledPlant, law: LinearLaw, delay: bool = False) -> np.nda
     delay : bool
         One-sample computational delay.
     """
-    A, Bw, Cu, _ = _blocks(sp, law, delay)
-    return A + Bw @ Cu
+    return LoopBlocks(sp, delayed(law) if delay else law).closed()
 
 
-def broken_loop(sp: SampledPlant, law: LinearLaw, delay: bool = False):
-    """The loop broken at the plant input: ``(A, B, C)`` from the input applied ``w_k`` to the
-    input the controller would apply ``o_k`` (the command, or with a delay the pending one):
-    ``s_{k+1} = A s_k + B w_k``, ``o_k = C s_k``. The return ratio is ``L = -o / w`` and the
-    closed loop ``w = o`` is :func:`loop_matrix`."""
-    A, Bw, Cu, _ = _blocks(sp, law, delay)
-    return A, Bw, Cu
+def broken_loop(sp: SampledPlant, law: LinearLaw, delay: bool = False, measured_input=False):
+    """The loop broken at the plant inputs: ``(A, B, C)`` from the input applied ``w_k`` to the
+    input the controller would apply ``o_k``: ``s_{k+1} = A s_k + B w_k``, ``o_k = C s_k``.
+    The return ratio is ``L = -o / w`` and the closed loop ``w = o`` is :func:`loop_matrix`.
+
+    ``measured_input``: the controller reads the applied input from hardware (so the
+    perturbation reaches its estimator too) instead of knowing its own command.
+    """
+    return LoopBlocks(sp, delayed(law) if delay else law, measured_input).at_inputs()

@@ -14,7 +14,8 @@ from .plant import Limits
 __all__ = ["ControllerSpec", "CONTROLLER_TYPES"]
 
 
-CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc", "hinf")
+CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc", "hinf", "linear", "gain", "python")
+"""Controller file types: designed here (lqr ... hinf) or brought (linear, gain, python)."""
 
 
 @dataclass(frozen=True)
@@ -26,7 +27,9 @@ class ControllerSpec:
     type : str
         ``"none"`` (open loop), ``"lqr"`` (full-state feedback), ``"lqg"`` (Kalman filter on
         the sensors + LQR), ``"mpc"`` (constrained MPC, casadi, Kalman filter) or ``"hinf"``
-        (H-infinity mixed sensitivity at the actuator).
+        (H-infinity mixed sensitivity at the actuator); brought from elsewhere: ``"linear"`` (a
+        saved compensator, :attr:`linear`), ``"gain"`` (a static gain, :attr:`gain`) or
+        ``"python"`` (a Python law, :attr:`python`).
     name : str
     bryson_outputs, bryson_inputs : dict
         Allowed output and control values (Bryson's rule), in the signals' units; for
@@ -46,6 +49,9 @@ class ControllerSpec:
         Variance of each disturbance input, e.g. ``{"gust": 1.0}`` [(m/s)^2] (LQG, MPC).
     sensor_noise : dict
         Variance of each sensor [unit^2] (LQG, MPC).
+    input_noise : dict
+        Loop transfer recovery: fictitious noise variance entering with each control
+        [unit^2] (LQG, MPC; :func:`aeroservo.design.lqg.kalman_filter`).
     horizon : int
         MPC horizon [samples].
     solver : str
@@ -56,6 +62,16 @@ class ControllerSpec:
         Relative weight of the squared slacks.
     schedule : tuple of float or None
         Gain-schedule design speeds as multiples of the open-loop flutter speed (LQR, LQG).
+    linear : dict or None
+        A saved compensator (``"linear"``): ``A, B, C, D``, ``dt`` [s] (0 continuous, None
+        the loop's), ``inputs`` (sensors), ``outputs`` (commands), ``source``, and how to
+        bring it: ``method``, ``prewarp`` [Hz], ``sign``, ``anti_windup`` (bool).
+    gain : dict or None
+        A static gain ``u = -K y`` (``"gain"``): ``K``, ``controls`` and ``sensors`` or
+        ``states``.
+    python : dict or None
+        A Python law (``"python"``): ``function`` (the callable ``fn(t, y)``), ``sensors``,
+        ``needs_state``, ``source``.
     source : str
         File the spec was read from.
     """
@@ -68,6 +84,7 @@ class ControllerSpec:
     limits: Limits = field(default_factory=Limits)
     process_noise: dict = field(default_factory=dict)
     sensor_noise: dict = field(default_factory=dict)
+    input_noise: dict = field(default_factory=dict)
     horizon: int = 20
     solver: str = "daqp"
     soft_outputs: dict = field(default_factory=dict)
@@ -76,6 +93,9 @@ class ControllerSpec:
     sensor_scales: dict = field(default_factory=dict)
     hinf: HinfWeights | None = None
     margins: MarginRequirement = field(default_factory=MarginRequirement)
+    linear: dict | None = None
+    gain: dict | None = None
+    python: dict | None = None
     source: str = "<dict>"
 
     @property
@@ -89,5 +109,11 @@ class ControllerSpec:
             "limits.rate": list(self.limits.rate),
             "estimator.process_noise": list(self.process_noise),
             "estimator.sensor_noise": list(self.sensor_noise),
+            "estimator.input_noise": list(self.input_noise),
             "mpc.soft_outputs": list(self.soft_outputs),
+            "linear inputs": list((self.linear or {}).get("inputs", [])),
+            "linear outputs": list((self.linear or {}).get("outputs", [])),
+            "gain.controls": list((self.gain or {}).get("controls", [])),
+            "gain.sensors": list((self.gain or {}).get("sensors") or []),
+            "python.sensors": list((self.python or {}).get("sensors") or []),
         }

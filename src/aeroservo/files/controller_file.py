@@ -3,7 +3,10 @@
 A controller file describes *how* to design a flutter-suppression controller, independently of
 the wing: the type (``lqr``, ``lqg``, ``mpc``, ``hinf`` or ``none`` for the open loop), Bryson
 weights or nominal magnitudes, actuator limits, estimator noise levels, MPC settings,
-H-infinity weights, an optional gain schedule and the loop-margin requirement. Scenarios
+H-infinity weights, an optional gain schedule and the loop-margin requirement; or it brings a
+controller designed elsewhere: a saved compensator (``linear``: ``.npz`` or MATLAB ``.mat``,
+:mod:`aeroservo.files.linear_controller`), a static gain (``gain``) or a Python law
+(``python``). Scenarios
 refer to it by path, so one wing can be tried with many controllers. Signal names are checked
 against the wing's model when a scenario is resolved.
 """
@@ -17,6 +20,7 @@ from ..design.margins import MarginRequirement
 from ..design.mpc import SOLVERS
 from ..design.plant import Limits
 from ..design.spec import CONTROLLER_TYPES, ControllerSpec
+from ..errors import InputError
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
 
 __all__ = ["load_controller", "controller_from_dict"]
@@ -26,6 +30,15 @@ TOP_KEYS = (
     "type",
     "name",
     "description",
+    "file",
+    "method",
+    "prewarp",
+    "sign",
+    "anti_windup",
+    "function",
+    "needs_state",
+    "sensors",
+    "gain",
     "weights",
     "limits",
     "estimator",
@@ -59,6 +72,9 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "lqg": ("weights", "estimator"),
         "mpc": ("weights", "estimator", "limits"),
         "hinf": ("weights",),
+        "linear": ("file",),
+        "gain": ("gain",),
+        "python": ("file", "function"),
     }[kind]
     allowed = {
         "none": ("limits",),
@@ -66,6 +82,9 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "lqg": ("weights", "estimator", "limits", "schedule", "margins"),
         "mpc": ("weights", "estimator", "limits", "mpc", "margins"),
         "hinf": ("weights", "limits", "hinf", "margins"),
+        "linear": ("file", "method", "prewarp", "sign", "anti_windup", "limits", "margins"),
+        "gain": ("gain", "limits", "margins"),
+        "python": ("file", "function", "sensors", "needs_state", "limits"),
     }[kind]
     for key in TOP_KEYS[3:]:
         if top.has(key) and key not in allowed:
@@ -73,7 +92,9 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         if key in needs and not top.has(key):
             raise_missing(top, key, kind)
 
-    if kind == "hinf":
+    if kind in ("linear", "gain", "python"):
+        brought(top, kind, kw, Path(file).parent)
+    elif kind == "hinf":
         w = top.table("weights").check_keys(("inputs", "sensors"))
         kw["bryson_inputs"] = w.number_map("inputs", quantity="bryson")
         kw["sensor_scales"] = w.number_map("sensors", quantity="bryson")
@@ -130,10 +151,11 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
                     lim.fail(k, lim.data[k], f"MPC needs a {k} limit for control {c!r}")
 
     est = top.table("estimator").check_keys(
-        ("process_noise", "sensor_noise") if top.has("estimator") else ()
+        ("process_noise", "sensor_noise") if top.has("estimator") else (), ("input_noise",)
     )
     kw["process_noise"] = est.number_map("process_noise", quantity="estimator_variance")
     kw["sensor_noise"] = est.number_map("sensor_noise", quantity="estimator_variance")
+    kw["input_noise"] = est.number_map("input_noise", quantity="input_noise")
     for k in ("process_noise", "sensor_noise"):
         if top.has("estimator") and not kw[k]:
             est.fail(k, est.data[k], "give at least one variance")
@@ -154,9 +176,78 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     return ControllerSpec(**kw)
 
 
-def raise_missing(table: Table, key: str, kind: str):
-    from ..errors import InputError
+def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
+    """The ``linear``, ``gain`` and ``python`` types: a controller designed elsewhere."""
+    if kind == "gain":
+        g = top.table("gain").check_keys(("controls", "matrix"), ("sensors", "states"))
+        if g.has("sensors") == g.has("states"):
+            g.fail("sensors", g.data.get("sensors"), "give sensors or states (one of them)")
+        controls = g.strings("controls")
+        cols = g.strings("sensors" if g.has("sensors") else "states")
+        rows = g.data["matrix"]
+        if not isinstance(rows, list) or len(rows) != len(controls):
+            g.fail("matrix", rows, f"expected {len(controls)} rows (one per control)")
+        K = []
+        for i, row in enumerate(rows):
+            if not isinstance(row, list) or len(row) != len(cols):
+                g.fail("matrix", rows, f"row {i}: expected {len(cols)} numbers")
+            K.append(
+                [
+                    g.check_value(f"matrix[{i}][{j}]", x, lo=-1e12, hi=1e12)
+                    for j, x in enumerate(row)
+                ]
+            )
+        kw["gain"] = {
+            "K": K,
+            "controls": controls,
+            ("sensors" if g.has("sensors") else "states"): cols,
+        }
+        return
+    path = top.path("file", base, required=True)
+    if kind == "python":
+        kw["python"] = {
+            "function": python_function(top, path, top.string("function", required=True)),
+            "sensors": top.strings("sensors") if top.has("sensors") else None,
+            "needs_state": top.boolean("needs_state", False),
+            "source": f"{path.name}:{top.data['function']}",
+        }
+        return
+    from ..design.compensator import DISCRETIZATIONS
+    from .linear_controller import read_linear_controller
 
+    try:
+        lin = read_linear_controller(path)
+    except InputError as exc:
+        top.fail("file", top.data["file"], str(exc))
+    lin["method"] = top.string("method", "tustin", choices=DISCRETIZATIONS)
+    lin["prewarp"] = top.number("prewarp", None, unit="Hz", lo=0.0, lo_open=True, hi=5e4)
+    lin["sign"] = top.integer("sign", 1, lo=-1, hi=1)
+    if lin["sign"] == 0:
+        top.fail("sign", 0, "expected 1 (the output is the command) or -1")
+    lin["anti_windup"] = top.boolean("anti_windup", True)
+    kw["linear"] = lin
+
+
+def python_function(top: Table, path: Path, name: str):
+    """The function ``name`` of the Python file ``path`` (run as a module, as the user's own
+    code); errors name the controller file's key."""
+    import importlib.util
+
+    if not path.is_file():
+        top.fail("file", top.data["file"], f"no such Python file ({path})")
+    try:
+        spec = importlib.util.spec_from_file_location(f"aeroservo_law_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    except Exception as exc:  # the user's code: any error is an input error here
+        top.fail("file", top.data["file"], f"running it failed: {type(exc).__name__}: {exc}")
+    fn = getattr(module, name, None)
+    if not callable(fn):
+        top.fail("function", name, f"{path.name} defines no function of that name")
+    return fn
+
+
+def raise_missing(table: Table, key: str, kind: str):
     raise InputError(
         f"{table.file}: {table.key_name(key)}: missing; a controller of type {kind!r} needs it"
     )

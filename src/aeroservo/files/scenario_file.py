@@ -16,7 +16,14 @@ from ..errors import MAX_ELEMENTS, InputError
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .scenario_checks import cross_check
-from .scenario_tables import controller, disturbance, flight, is_file, trade_table
+from .scenario_tables import (
+    controller,
+    disturbance,
+    engaged_speeds,
+    flight,
+    is_file,
+    trade_table,
+)
 from .toml_tables import Table, check_integers, is_scenario_file, one_line_errors, read_toml
 from .wing_file import damping_from_dict
 
@@ -195,9 +202,20 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["filter_order"] = sg.integer("filter_order", 2, lo=1, hi=4)
 
     sim = top.table("simulation").check_keys(
-        (), ("duration", "sample_rate", "delay", "seed", "sensor_noise", "expect_unstable")
+        (),
+        (
+            "duration",
+            "sample_rate",
+            "delay",
+            "seed",
+            "sensor_noise",
+            "expect_failure",
+            "expect_unstable",
+        ),
     )
-    kw["expect_unstable"] = sim.boolean("expect_unstable", False)
+    if sim.has("expect_failure") and sim.has("expect_unstable"):
+        sim.fail("expect_unstable", sim.data["expect_unstable"], "give expect_failure only")
+    kw["expect_failure"] = sim.boolean("expect_failure", sim.boolean("expect_unstable", False))
     kw["duration"] = sim.number("duration", 2.0, quantity="duration")
     kw["sample_rate"] = sim.number("sample_rate", 1000.0, quantity="sample_rate")
     kw["delay"] = sim.boolean("delay", False)
@@ -228,9 +246,13 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
 
     if kind == "simulate":
         kw["disturbance"] = disturbance(top.table("disturbance"), base, wing.span)
-        ct = top.table("controller", required=True).check_keys(("spec",))
+        ct = top.table("controller", required=True).check_keys(
+            ("spec",), ("engaged_speeds", "engaged_speed_factors", "flutter_margin")
+        )
         spec_path = ct.path("spec", base, required=True)
         kw["controller"] = controller(ct, spec_path)
+        engaged_speeds(ct, kw)
+        kw["flutter_margin"] = ct.number("flutter_margin", 1.15, lo=1.0, hi=3.0)
     if kind == "trade":
         kw["trade"] = trade_table(top.table("trade", required=True), base)
 

@@ -166,6 +166,27 @@ def is_file(path: Path) -> bool:
         return False
 
 
+def engaged_speeds(ct: Table, kw: dict) -> None:
+    """``engaged_speeds`` [m/s] or ``engaged_speed_factors`` (x V_f) of ``[controller]``: the
+    speeds where the loop is engaged, two increasing values (default: 0.5 V_f to 1.15 x the
+    scenario speed)."""
+    if ct.has("engaged_speeds") and ct.has("engaged_speed_factors"):
+        ct.fail(
+            "engaged_speed_factors",
+            ct.data["engaged_speed_factors"],
+            "give engaged_speeds or engaged_speed_factors, not both",
+        )
+    for key, quantity in (
+        ("engaged_speeds", "flight_speed"),
+        ("engaged_speed_factors", "speed_factor"),
+    ):
+        v = ct.numbers(key, quantity=quantity, increasing=True)
+        if v is not None:
+            if len(v) != 2:
+                ct.fail(key, ct.data[key], "expected [low, high]")
+            kw[key] = tuple(v)
+
+
 def controller(ct: Table, path: Path, key: str = "spec") -> ControllerSpec:
     """The controller file ``path`` named by ``key``; its errors also name this file."""
     if not is_file(path):

@@ -9,7 +9,23 @@ import numpy as np
 from ..design.plant import Limits
 from ..errors import InputError
 
-__all__ = ["SimulationResult"]
+__all__ = ["SimulationResult", "WINDUP_RATIO", "windup_text"]
+
+WINDUP_RATIO = 10.0
+"""A command beyond this many times its magnitude limit is reported as winding up."""
+
+
+def windup_text(wound: dict) -> str:
+    """One line on the controls of :meth:`SimulationResult.windup`."""
+    parts = [
+        f"{c} commanded up to {w['peak_command']:.3g} against a limit of {w['limit']:.4g} "
+        f"({w['ratio']:.3g} x)"
+        for c, w in wound.items()
+    ]
+    return (
+        "the controller's commands run away while the actuator saturates (windup, or a loop "
+        "its limits cannot hold): " + "; ".join(parts)
+    )
 
 
 @dataclass
@@ -71,6 +87,18 @@ class SimulationResult:
             c: float(np.mean(np.abs(u) >= mag[i] * (1 - 1e-12)))
             for i, (c, u) in enumerate(self.applied.items())
         }
+
+    def windup(self, ratio: float = WINDUP_RATIO) -> dict:
+        """Controls whose commands ran away beyond their magnitude limit: ``{control:
+        {"peak_command", "limit", "ratio"}}`` for a peak ``|command|`` above ``ratio`` x the
+        limit, or not finite (empty: none)."""
+        mag, _ = self.limits.arrays(list(self.commands))
+        out = {}
+        for i, (c, cmd) in enumerate(self.commands.items()):
+            peak = float(np.max(np.abs(cmd))) if np.all(np.isfinite(cmd)) else float("inf")
+            if np.isfinite(mag[i]) and peak > ratio * mag[i]:
+                out[c] = {"peak_command": peak, "limit": float(mag[i]), "ratio": peak / mag[i]}
+        return out
 
     def rate_limited_fraction(self) -> dict:
         """Share of samples at which each control moved at its rate limit (the command was

@@ -42,7 +42,9 @@ class Run:
     margins : LoopMargins or None
         Loop margins at the actuator at the scenario's speed (controlled loops).
     margin_sweep : MarginSweep or None
-        The margins over the boundary's speed range, when the boundary is computed.
+        The margins across the engaged speed range (linear controllers).
+    judgement : LoopJudgement or SimulatedJudgement or None
+        The loop judged over its engaged speed range (controlled loops).
     trade : TradeResult or None
         Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
     folder : Path or None
@@ -58,6 +60,7 @@ class Run:
     boundary: object = None
     margins: object = None
     margin_sweep: object = None
+    judgement: object = None
     trade: object = None
     folder: Path | None = None
     title: str = ""
@@ -214,8 +217,14 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     limited = {c: max(sat[c], rl[c]) for c in sat}
     summary.update(loop_verdict(plant, at, scenario.delay, summary["signals"], limited))
 
-    summary["expect_unstable"] = scenario.expect_unstable
+    summary["expect_failure"] = scenario.expect_failure
     summary["response"] = "grows" if summary["growing_signals"] else "decays"
+    wound = result.windup()
+    if wound:
+        from ..simulate.result import windup_text
+
+        summary["windup"] = wound
+        summary.setdefault("warnings", []).append(windup_text(wound))
     if result.status:
         times = np.array([s["solve_time"] for s in result.status])
         summary["mpc"] = {
@@ -232,8 +241,10 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         speed,
         vf,
         lambda total, label: _progress_bar(total, label, progress),
+        x0=x0,
     )
     summary.update(analysis.summary(vf))
+    _final_verdict(summary, analysis)
     summary["wall_time"] = time.perf_counter() - t0
     return Run(
         scenario,
@@ -243,7 +254,28 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         boundary=analysis.boundary,
         margins=analysis.margins,
         margin_sweep=analysis.sweep,
+        judgement=analysis.judgement,
     )
+
+
+def _final_verdict(summary: dict, analysis) -> None:
+    """The run's verdict over its engaged range: ``verdict`` "unstable" if the loop is unstable
+    at the scenario's speed or anywhere in the engaged range; ``passed`` if it is stable and
+    meets its margin requirement over the range (and at the speed); ``hint`` the one line that
+    says why not."""
+    j = analysis.judgement
+    lines = [] if j is None else j.lines()
+    if j is not None and not j.stable and summary["verdict"] == "stable":
+        summary["verdict"] = "unstable"
+        summary["hint"] = lines[0]
+    margins = summary.get("margins")
+    met = (margins is None or margins["meets"]) and (j is None or j.meets_requirement is not False)
+    summary["passed"] = summary["verdict"] == "stable" and met
+    if margins is not None and not margins["meets"] and not lines:
+        lines = [f"loop margins miss the requirement: {'; '.join(margins['violations'])}"]
+    if not summary["passed"] and "hint" not in summary:
+        summary["hint"] = lines[0] if lines else "the loop fails its verdict"
+    summary["verdict_lines"] = lines
 
 
 @blas_limited

@@ -72,7 +72,10 @@ class Scenario:
     duration: float = 2.0
     sample_rate: float = 1000.0
     delay: bool = False
-    expect_unstable: bool = False
+    expect_failure: bool = False
+    engaged_speeds: tuple | None = None
+    engaged_speed_factors: tuple | None = None
+    flutter_margin: float = 1.15
     seed: int = 0
     sensor_noise: dict = field(default_factory=dict)
     closed_loop_boundary: bool = False
@@ -88,6 +91,32 @@ class Scenario:
         from ..system.aeroelastic import AeroelasticModel
 
         return AeroelasticModel(self.wing, self.elements, self.wagner, damping=self.damping)
+
+    def engaged_range(self, flutter_speed: float | None, speed: float):
+        """The speeds where the loop is engaged (:class:`~aeroservo.design.EngagedRange`):
+        ``controller.engaged_speeds`` [m/s], ``controller.engaged_speed_factors`` (x the
+        open-loop flutter speed), or the default (0.5 V_f to ``speed``); stability is judged up
+        to ``controller.flutter_margin`` x its top."""
+        from dataclasses import replace
+
+        return replace(self._engaged(flutter_speed, speed), flutter_margin=self.flutter_margin)
+
+    def _engaged(self, flutter_speed: float | None, speed: float):
+        from ..design.judgement import EngagedRange
+
+        if self.engaged_speeds is not None:
+            return EngagedRange(*self.engaged_speeds, "scenario: controller.engaged_speeds")
+        if self.engaged_speed_factors is not None:
+            if flutter_speed is None:
+                raise ArithmeticError(
+                    f"{self.source}: controller.engaged_speed_factors needs the open-loop "
+                    "flutter speed, but the wing has none in the searched range"
+                )
+            lo, hi = (f * flutter_speed for f in self.engaged_speed_factors)
+            return EngagedRange(
+                lo, hi, "scenario: controller.engaged_speed_factors x the open-loop V_f"
+            )
+        return EngagedRange.default(flutter_speed, speed)
 
     @property
     def atmosphere(self):

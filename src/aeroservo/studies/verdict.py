@@ -4,14 +4,17 @@ scenario's speed and the growth of every recorded signal, controls included.
 * The **loop**: the spectral radius ``rho`` of the transition matrix of the sampled loop
   (:func:`aeroservo.design.closed_loop_matrix`, the loop the simulator marches, delay included;
   an MPC as its unconstrained LQG); ``rho >= 1`` is an unstable loop, whatever a short
-  simulation shows.
+  simulation shows. A nonlinear controller (a Python law) has no such matrix: its verdict at
+  the speed rests on the signals.
 * The **signals**: the growth of a signal is the largest ``|y|`` over the last
   :data:`TAIL` of the record divided by its largest value before; above :data:`GROWS` the
   response is still growing at the end (a nonlinear loop, e.g. saturated, can diverge while
   its linear part is stable).
 
-The verdict is ``"unstable"`` if either says so. The command line then exits with status 3
-(unless the scenario sets ``simulation.expect_unstable = true``).
+The verdict is ``"unstable"`` if either says so, or if the loop is unstable anywhere in its
+engaged range (:mod:`aeroservo.studies.loop_analysis`). A run *passes* when it is stable and
+meets its margin requirement over the engaged range; otherwise the command line exits with
+status 3 (unless the scenario sets ``simulation.expect_failure = true``).
 """
 
 from __future__ import annotations
@@ -77,14 +80,28 @@ def loop_verdict(
         unstable, a one-line ``hint``.
     """
     from ..design.closed_loop import closed_loop_matrix
-    from ..design.sampled_loop import linear_law
+    from ..design.interface import has_linear_law
+    from ..design.sampled_loop import linear_law, plant_states
 
+    growing = sorted(n for n, v in signals.items() if np.nan_to_num(v["growth"]) > GROWS)
+    if not has_linear_law(controller):
+        out = {
+            "verdict": "unstable" if growing else "stable",
+            "spectral_radius": None,
+            "growth_rate": None,
+            "critical_frequency": None,
+            "growing_signals": growing,
+        }
+        if growing:
+            out["hint"] = (
+                f"closed loop unstable: {', '.join(growing)} grow under the nonlinear controller"
+            )
+        return out
     A, dt = closed_loop_matrix(plant, controller, delay=delay)
     lam = np.linalg.eigvals(A)
     i = int(np.argmax(np.abs(lam)))
     rho = float(np.abs(lam[i]))
     s = np.log(complex(lam[i])) / dt
-    growing = sorted(n for n, v in signals.items() if np.nan_to_num(v["growth"]) > GROWS)
     unstable = rho > 1.0 + 1e-12 or bool(growing)
     out = {
         "verdict": "unstable" if unstable else "stable",
@@ -100,8 +117,8 @@ def loop_verdict(
             if rho > 1.0 + 1e-12
             else f"the loop's spectral radius is {rho:.6g}, but {', '.join(growing)} still grow"
         )
-        law = linear_law(controller, plant.nstates)
-        kind = "open" if law.kind == "state" and not np.any(law.G) else law.kind
+        law = linear_law(controller, plant_states(plant))
+        kind = "open" if not law.has_feedback else law.kind
         hint = f"closed loop unstable: {why}; {_REMEDIES[kind]}"
         busy = {k: v for k, v in (limited or {}).items() if v >= 0.5}
         if busy:

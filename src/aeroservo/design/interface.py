@@ -1,0 +1,295 @@
+"""The controller interface: anything that maps sensors (or plant states) to commands at a sample
+rate, accepted the same way by the simulator, the closed-loop boundary, the margins, the
+verdicts, scenarios and trade studies.
+
+:func:`as_controller` takes
+
+* a controller of :mod:`aeroservo.design` (LQR, LQG, MPC, H-infinity, gain schedule, open loop,
+  :class:`~aeroservo.design.compensator.DiscreteCompensator`, :class:`StateGain`,
+  :class:`PythonLaw`): returned as it is;
+* a python-control ``StateSpace`` or ``TransferFunction`` whose inputs are named after sensors
+  and outputs after controls: discrete at the loop's period, or continuous and discretised at
+  the loop's sample rate (:func:`~aeroservo.design.compensator.compensator_from_lti`);
+* an object with the sampled-controller protocol (``dt``, ``controls``, ``reset``,
+  ``command(y, x)``, ``update(y, u)``): a nonlinear law, simulated as it is.
+
+Static gains (:func:`static_gain`, on named sensors or named plant states) and Python functions
+(:func:`python_law`) need their signal names, so they are built by those functions. Anything
+else is an :class:`~aeroservo.errors.InputError`. Linear controllers have a
+:class:`~aeroservo.design.law.LinearLaw` (``law``); the linear analyses (boundary, margins)
+refuse a controller without one, never treating it as an open loop.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, check_number
+from ..linear.signals import check_names, describe
+from .compensator import DiscreteCompensator, compensator_from_lti
+from .law import LinearLaw, state_gain
+
+__all__ = [
+    "as_controller",
+    "static_gain",
+    "python_law",
+    "StateGain",
+    "PythonLaw",
+    "has_linear_law",
+    "PROTOCOL",
+]
+
+PROTOCOL = ("dt", "controls", "reset", "command", "update")
+"""Attributes of a sampled controller (the protocol :func:`aeroservo.simulate.simulate` runs)."""
+
+ACCEPTED = (
+    "a controller of aeroservo.design (lqr, lqg, mpc, hinf, schedule, static_gain, "
+    "python_law, DiscreteCompensator), a python-control StateSpace or TransferFunction with "
+    "inputs named after sensors and outputs after controls, or an object with dt, controls, "
+    "reset(), command(y, x) and update(y, u)"
+)
+
+
+def has_linear_law(controller) -> bool:
+    """Whether a controller (or a gain schedule) has a linear law the analyses can use."""
+    return callable(getattr(controller, "law", None)) or hasattr(controller, "at")
+
+
+def _sample_period(sample_rate: float | None) -> float | None:
+    if sample_rate is None:
+        return None
+    return 1.0 / check_number("sample_rate", sample_rate, unit="Hz", lo=1.0, hi=1e5)
+
+
+def as_controller(
+    obj,
+    *,
+    sample_rate: float | None = None,
+    method: str = "tustin",
+    prewarp: float | None = None,
+    sign: int = 1,
+) -> object:
+    """Any supported controller as a sampled controller of this package (module docstring).
+
+    Parameters
+    ----------
+    obj
+        The controller.
+    sample_rate : float, optional
+        The loop's sample rate [Hz]: discretises a continuous python-control system, and is
+        checked against the period of a discrete one.
+    method, prewarp, sign
+        Discretisation and sign of a python-control system, see
+        :func:`~aeroservo.design.compensator.compensator_from_lti`.
+
+    Raises
+    ------
+    InputError
+        For an object that is none of the accepted kinds, or a period other than the loop's.
+    """
+    dt_loop = _sample_period(sample_rate)
+    if has_linear_law(obj) or all(hasattr(obj, a) for a in PROTOCOL):
+        dt = getattr(obj, "dt", None)
+        if not isinstance(dt, (int, float, np.floating)) or isinstance(dt, bool) or not dt > 0:
+            raise InputError(f"controller.dt = {describe(dt)}: expected a sample period [s] > 0")
+        if dt_loop is not None and abs(dt - dt_loop) > 1e-9 * dt_loop:
+            raise InputError(
+                f"controller.dt = {dt:g} s ({1 / dt:g} Hz): the loop samples at {1 / dt_loop:g} Hz"
+            )
+        return obj
+    if type(obj).__module__.startswith("control."):
+        import control
+
+        if isinstance(obj, (control.StateSpace, control.TransferFunction)):
+            return compensator_from_lti(
+                obj, sample_rate=sample_rate, method=method, prewarp=prewarp, sign=sign
+            )
+    if isinstance(obj, (np.ndarray, list, tuple, int, float)):
+        raise InputError(
+            f"controller = {describe(obj)}: a gain matrix needs its signal names: "
+            "aeroservo.design.static_gain(K, controls=[...], sensors=[...] or states=[...], "
+            "sample_rate=...)"
+        )
+    if callable(obj):
+        raise InputError(
+            f"controller = {describe(obj)}: a Python function needs its signals: "
+            "aeroservo.design.python_law(fn, controls=[...], sensors=[...], sample_rate=...)"
+        )
+    raise InputError(f"controller = {describe(obj)}: expected {ACCEPTED}")
+
+
+@dataclass
+class StateGain:
+    """``u = -K x[states]``: a static gain on named plant states.
+
+    The states are those of the plant the loop closes around (``plant.state_labels``; the
+    models of :class:`~aeroservo.StateSpaceBuilder` and ``aes.statespace`` are balanced, so a
+    gain designed on them applies as it is). Use :func:`static_gain` to build one.
+    """
+
+    K: np.ndarray
+    controls: tuple
+    states: tuple
+    dt: float
+    design_speed: float = float("nan")
+    needs_state: bool = True
+    _gain: np.ndarray | None = field(default=None, repr=False)
+
+    def law(self, states: Sequence[str]) -> LinearLaw:
+        """The law on a plant with the named ``states`` (every named state must be one)."""
+        states = list(states)
+        missing = [s for s in self.states if s not in states]
+        if missing:
+            raise InputError(
+                f"static gain: states {missing[:5]} are not states of the plant "
+                f"({len(states)} states, e.g. {states[:4]})"
+            )
+        G = np.zeros((len(self.controls), len(states)))
+        G[:, [states.index(s) for s in self.states]] = self.K
+        self._gain = G
+        return state_gain(G, self.controls, self.dt, source="static state gain")
+
+    def reset(self) -> None:
+        pass
+
+    def command(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        if self._gain is None or self._gain.shape[1] != np.size(x):
+            raise InputError("static gain: call law(plant.state_labels) before stepping it")
+        return -(self._gain @ x)
+
+    def update(self, y: np.ndarray, u: np.ndarray) -> None:
+        pass
+
+
+def static_gain(
+    K,
+    controls: Sequence[str],
+    *,
+    sensors: Sequence[str] | None = None,
+    states: Sequence[str] | None = None,
+    sample_rate: float,
+) -> DiscreteCompensator | StateGain:
+    """A static output or state feedback ``u = -K y`` (or ``u = -K x``, the LQR convention).
+
+    Parameters
+    ----------
+    K : array_like (n_controls, n_sensors or n_states)
+        The gain, in the signals' units (e.g. N m per m/s^2).
+    controls : sequence of str
+        The commands (rows of K).
+    sensors, states : sequence of str
+        The measured sensors, or the plant states, the columns of K refer to (exactly one).
+    sample_rate : float
+        [Hz]
+
+    Returns
+    -------
+    DiscreteCompensator (no state) or StateGain
+    """
+    controls = tuple(check_names("controls", controls))
+    if (sensors is None) == (states is None):
+        raise InputError("static_gain: give either sensors=[...] or states=[...], not both")
+    cols = tuple(check_names("sensors" if states is None else "states", sensors or states))
+    try:
+        G = np.atleast_2d(np.asarray(K, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"K = {describe(K)}: expected a real matrix") from None
+    if G.shape != (len(controls), len(cols)):
+        raise InputError(
+            f"K has shape {G.shape}; expected {(len(controls), len(cols))} "
+            f"(controls x {'sensors' if states is None else 'states'})"
+        )
+    if not np.all(np.isfinite(G)):
+        raise InputError("K has NaN or infinite entries")
+    dt = _sample_period(sample_rate)
+    if states is not None:
+        return StateGain(G, controls, cols, dt)
+    z = np.zeros
+    return DiscreteCompensator(
+        z((0, 0)), z((0, len(cols))), z((len(controls), 0)), -G, controls, cols, dt,
+        source="static output gain",
+    )  # fmt: skip
+
+
+@dataclass
+class PythonLaw:
+    """A nonlinear or adaptive law written in Python (simulated; no linear analyses).
+
+    ``fn(t, y)`` (or ``fn(t, y, x)`` with ``needs_state``) returns the commands at time ``t``
+    [s] from the sensor values ``y`` (and the plant state ``x``); ``reset()`` (optional) is
+    called before each run. Use :func:`python_law` to build one.
+    """
+
+    fn: Callable
+    controls: tuple
+    sensors: tuple
+    dt: float
+    needs_state: bool = False
+    on_reset: Callable | None = None
+    name: str = "Python law"
+    is_linear: bool = False
+
+    def reset(self) -> None:
+        self._k = 0
+        if self.on_reset is not None:
+            self.on_reset()
+
+    def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
+        t = self._k * self.dt
+        out = self.fn(t, y, x) if self.needs_state else self.fn(t, y)
+        try:
+            c = np.asarray(out, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            c = np.array([np.nan])
+        if c.size != len(self.controls) or not np.all(np.isfinite(c)):
+            raise InputError(
+                f"{self.name}: returned {describe(out)} at t = {t:g} s; expected "
+                f"{len(self.controls)} finite commands {list(self.controls)}"
+            )
+        return c
+
+    def update(self, y: np.ndarray, u: np.ndarray) -> None:
+        self._k += 1
+
+
+def python_law(
+    fn: Callable,
+    controls: Sequence[str],
+    sensors: Sequence[str] = (),
+    *,
+    sample_rate: float,
+    needs_state: bool = False,
+    reset: Callable | None = None,
+    name: str | None = None,
+) -> PythonLaw:
+    """A controller from a Python function ``fn(t, y) -> commands`` (see :class:`PythonLaw`).
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(t [s], y)`` or, with ``needs_state``, ``fn(t, y, x)``; returns one command per
+        control, in the controls' units.
+    controls, sensors : sequence of str
+    sample_rate : float
+        [Hz]
+    needs_state : bool
+        Pass the plant state too.
+    reset : callable, optional
+        Called before each simulation (to clear the law's own memory).
+    """
+    if not callable(fn):
+        raise InputError(f"fn = {describe(fn)}: expected a function fn(t, y)")
+    if reset is not None and not callable(reset):
+        raise InputError(f"reset = {describe(reset)}: expected a function of no argument")
+    return PythonLaw(
+        fn,
+        tuple(check_names("controls", controls)),
+        tuple(check_names("sensors", sensors, empty=True)),
+        _sample_period(sample_rate),
+        bool(needs_state),
+        reset,
+        name or getattr(fn, "__name__", "Python law"),
+    )
