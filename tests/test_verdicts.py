@@ -50,7 +50,9 @@ def test_unstable_design_gets_verdict_results_and_exit_3(tmp_path, capsys):
     """An LQG on 8 design modes with optimistic accelerometer noise and 100 Hz filters is unstable
     on the full plant: verdict "unstable", spectral radius > 1, one line with a hint, results
     still written, exit status 3."""
-    path = variant(tmp_path, "goland_aileron_lqg", "lqg.toml", OPTIMISTIC, FAST_FILTERS, EIGHT_MODES)
+    path = variant(
+        tmp_path, "goland_aileron_lqg", "lqg.toml", OPTIMISTIC, FAST_FILTERS, EIGHT_MODES
+    )
     out = tmp_path / "out"
     code = cli.main(["run", str(path), "--quick", "--json", "--out", str(out)])
     cap = capsys.readouterr()
