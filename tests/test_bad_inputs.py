@@ -37,7 +37,7 @@ from aeroservo.files.user_files import read_text
 GOLAND = (ROOT / "scenarios" / "goland.toml").read_text()
 AILERON = (ROOT / "scenarios" / "goland_aileron.toml").read_text()
 SCENARIO = (ROOT / "scenarios" / "goland_aileron_lqr.toml").read_text()
-TRADE = "aeroservo-trade/1"  # the trade study's manifest format
+TRADE = "aeroservo-trade/2"  # the trade study's manifest format
 PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4
 
 

@@ -248,10 +248,19 @@ def test_invalid_study(study, change, match):
         trade.TradeStudy(**kw)
 
 
-def test_nonlinear_controller_rejected(study):
+def test_controller_without_linear_law_rejected(study, tmp_path):
+    """Issue 24: a Python law has no closed-loop boundary, so a trade study refuses it; an MPC
+    is accepted (judged by its law without active constraints, its gust flown as an MPC)."""
+    from aeroservo.files.controller_file import controller_from_dict
+
+    (tmp_path / "law.py").write_text("def law(t, y):\n    return [0.0]\n")
+    spec = controller_from_dict(
+        {"type": "python", "file": "law.py", "function": "law"}, str(tmp_path / "c.toml")
+    )
+    with pytest.raises(InputError, match="controller.type = 'python'"):
+        dataclasses.replace(study, controller=spec)
     mpc = load_controller(ROOT / "controllers" / "mpc.toml")
-    with pytest.raises(InputError, match="controller.type = 'mpc'"):
-        dataclasses.replace(study, controller=mpc)
+    assert dataclasses.replace(study, controller=mpc).controller.type == "mpc"
 
 
 def test_bad_scheduler_address(study, tmp_path):

@@ -7,7 +7,9 @@ The loop of :mod:`aeroservo.design.sampled_loop` (plant, filters, controller, de
   the command it computed, only the plant sees the perturbation (the default; the requirement
   is judged here). ``measured_input=True`` models hardware that measures the input applied
   (e.g. the hinge moment) and feeds it to the controller's estimator: then the perturbation
-  reaches the estimator too, and the margins are those of that hardware only;
+  reaches the estimator too, and the margins are those of that hardware only (a controller
+  without an estimator, such as H-infinity, gives the black-box figures: its anti-windup
+  compares its command with the limited value software knows, not with a measurement);
 * **at each sensor** (the plant output), one at a time with the actuators closed (reported);
 * **at all plant inputs at once**: the simultaneous (multiloop) disk margin, independent
   gain-phase variations in every channel (Seiler, Packard & Gahinet, "An introduction to disk

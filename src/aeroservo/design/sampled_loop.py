@@ -95,7 +95,10 @@ class LoopBlocks:
             Cm = np.zeros((len(law.sensors), N))
             Cm[:, ix] = sp.C
             Cm[:, ih] = sp.Du
-        Lm = law.L if measured_input else np.zeros_like(law.L)
+        # only an estimator's prediction can be fed by a measurement; anti-windup compares the
+        # command with its limited value, which software knows
+        feeds = measured_input and law.applied_input == "prediction"
+        Lm = law.L if feeds else np.zeros_like(law.L)
         Az = np.zeros((N, N))
         Bw = np.zeros((N, m))
         Bv = np.zeros((N, Cm.shape[0]))

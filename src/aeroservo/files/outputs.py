@@ -2,8 +2,9 @@
 
 A flutter run writes ``<result>.json`` and ``<result>_vg.png``; a simulation writes
 ``<result>.npz`` (:mod:`aeroservo.files.results`), ``<result>.png``, ``<result>_margins.png``
-(Nyquist and Bode at the actuator) for a controlled loop, ``<result>_boundary.png`` and
-``<result>_margin_sweep.png`` when the closed-loop boundary was computed, and
+(Nyquist, Bode, S and T at the actuator), ``<result>_boundary.png`` (closed-loop stability over
+speed, the engaged range shaded) and ``<result>_margin_sweep.png`` (margins across the engaged
+range) for a controlled linear loop, and
 ``<result>.json``; a trade study writes
 
 ``summary.json``, ``heatmap.png`` and ``pareto.png`` into its folder (next to its case store,
@@ -64,9 +65,19 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
         if plots:
             png = out / f"{sc.result}.png"
             add("plot", png, figure_writer(run.simulation.plot(), png, dpi=120))
-            if run.boundary is not None:
+            judged = getattr(run.judgement, "boundary", None)
+            boundary = run.boundary if run.boundary is not None else judged
+            if boundary is not None:
                 png = out / f"{sc.result}_boundary.png"
-                fig = run.boundary.plot(open_loop=run.flutter)
+                e = run.judgement.engaged
+                fig = boundary.plot(open_loop=run.flutter, engaged=(e.low, e.high))
+                if e.stable_to > e.high:
+                    fig.axes[0].axvline(e.stable_to, color="g", ls=":", lw=1)
+                fig.axes[0].set_title(
+                    f"{sc.name}\nengaged {e.text()} (shaded), stability required to "
+                    f"{e.stable_to:.4g} m/s (dotted)",
+                    fontsize=9,
+                )
                 add("boundary_plot", png, figure_writer(fig, png, dpi=120))
             if run.margins is not None:
                 from ..plots import plot_loop_margins, plot_margin_sweep

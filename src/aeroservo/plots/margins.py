@@ -34,8 +34,9 @@ def _disk(ax, size: float, **kw) -> None:
 
 
 def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: str | None = None):
-    """Nyquist diagram (left, zoomed on -1) and broken-loop Bode diagram (right) of one control
-    channel, with its gain, phase and disk margins and the requirement.
+    """Nyquist diagram (left, zoomed on -1), broken-loop Bode diagram and the sensitivity ``S``
+    and complementary sensitivity ``T`` at the plant input (right) of one control channel, with
+    its gain, phase and disk margins, the requirement and the break point.
 
     Parameters
     ----------
@@ -47,11 +48,12 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
     control = control or next(iter(margins.channels))
     ch = margins.channels[control]
     req = margins.requirement
-    fig = _figure(figsize=(11.0, 5.2))
-    grid = fig.add_gridspec(2, 2, width_ratios=[1.0, 1.25])
+    fig = _figure(figsize=(11.5, 7.0))
+    grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.25])
     ax_n = fig.add_subplot(grid[:, 0])
     ax_m = fig.add_subplot(grid[0, 1])
     ax_p = fig.add_subplot(grid[1, 1], sharex=ax_m)
+    ax_s = fig.add_subplot(grid[2, 1], sharex=ax_m)
     L = ch.response
     f = ch.omega / (2 * np.pi)
 
@@ -74,7 +76,7 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
         alpha=0.15,
         label=f"disk margin alpha = {ch.disk_margin:.3g}",
     )
-    ax_n.plot(L.real, L.imag, "C0", lw=1.2, label="L(e^{j w dt}), 0 to Nyquist")
+    ax_n.plot(L.real, L.imag, "C0", lw=1.2, label=r"$L(e^{j\omega\Delta t})$, 0 to Nyquist")
     ax_n.plot(L.real, -L.imag, "C0", lw=0.8, ls="--", alpha=0.6)
     u = np.linspace(0, 2 * np.pi, 200)
     ax_n.plot(np.cos(u), np.sin(u), color="0.6", lw=0.8, ls=":")
@@ -114,18 +116,40 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
     ax_m.set_ylabel("|L| [dB]")
     ax_p.set_ylabel("phase of L + 180 [deg]")
     ax_p.set_yticks([-180, -90, 0, 90, 180])
-    ax_p.set_xlabel("frequency [Hz]")
-    for ax in (ax_m, ax_p):
+    _sensitivity(ax_s, margins)
+    for ax in (ax_m, ax_p, ax_s):
         ax.grid(True, which="both", alpha=0.3)
     status = "meets" if not ch.violations(req) else "MISSES"
     fig.suptitle(
         (title + "\n" if title else "")
-        + f"loop broken at {control}, V = {margins.speed:.4g} m/s"
+        + f"V = {margins.speed:.4g} m/s, loop broken at {control}: {margins.break_point}"
         + (", one-sample delay" if margins.delay else "")
-        + f": {status} the requirement",
-        fontsize=10,
+        + f"; {status} the requirement",
+        fontsize=9,
     )
     return fig
+
+
+def _sensitivity(ax, margins: LoopMargins) -> None:
+    """|S| and |T| at the plant input [dB] (largest singular values) with their peaks."""
+    s = margins.sensitivity
+    f = s["omega"] / (2 * np.pi)
+    keep = f > 0
+    for key, color, name in (("S", "C0", "S = (I + L)^-1"), ("T", "C1", "T = I - S")):
+        db = 20 * np.log10(np.maximum(s[key][keep], 1e-300))
+        peak = s[f"peak_{key}"]
+        ax.semilogx(
+            f[keep],
+            db,
+            color,
+            label=f"|{name}|, peak {peak:.3g} ({20 * np.log10(peak):.3g} dB) at "
+            f"{s[f'peak_{key}_frequency']:.3g} Hz",
+        )
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_ylim(-40, max(10.0, 20 * np.log10(max(s["peak_S"], s["peak_T"])) + 5))
+    ax.set_ylabel("plant input [dB]")
+    ax.set_xlabel("frequency [Hz]")
+    ax.legend(fontsize=7, loc="lower left")
 
 
 def plot_margin_sweep(sweep: MarginSweep, control: str | None = None, title: str | None = None):
@@ -166,14 +190,15 @@ def plot_margin_sweep(sweep: MarginSweep, control: str | None = None, title: str
             ax.axvspan(0.5 * (lo + v[i]), 0.5 * (hi + v[i]), color="0.85", lw=0)
         if sweep.reference_speed is not None:
             ax.axvline(sweep.reference_speed, color="g", ls="--", lw=1)
-    rng = sweep.meeting_range(control)
+    meets = t["meets"]
     note = (
-        f"requirement met from {rng[0]:.4g} to {rng[1]:.4g} m/s"
-        if rng
-        else "requirement not met at the reference speed"
+        "requirement met at every speed"
+        if meets.all()
+        else f"requirement MISSED at {np.count_nonzero(~meets)} of {meets.size} speeds"
     )
     fig.suptitle(
-        (title + "\n" if title else "") + f"margins at {control} versus airspeed: {note}\n"
+        (title + "\n" if title else "")
+        + f"margins at {control} (controller a black box) versus airspeed: {note}\n"
         "(grey: closed loop unstable; green: design speed; infinite margins at the axis limits)",
         fontsize=9,
     )

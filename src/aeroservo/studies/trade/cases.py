@@ -234,6 +234,14 @@ def _closed_loop(
         rec["closed_loop_flutter_speed"] = v_cl
         rec["closed_loop_flutter_frequency"] = _num(onset["frequency"])
         rec["suppression_margin"] = v_cl / v_ol - 1.0
+    if stable:
+        from ...design.margins import loop_margins
+
+        rec["closed_loop_lower_speed"] = _num(b.lower_speed)
+        ch = loop_margins(loop.plant(speed), ctrl, sensors=False).channels[study.controls[0]]
+        for key in ("gain_margin_db", "gain_reduction_margin_db", "phase_margin_deg"):
+            rec[key] = _num(getattr(ch, key))
+        rec["disk_margin"] = _num(ch.disk_margin)
 
     stage[0] = "gust"
     gust = OneMinusCosine(study.gust_length, study.gust_amplitude, 0.0)

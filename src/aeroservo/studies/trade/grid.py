@@ -26,6 +26,10 @@ def _jsonable(obj: object) -> object:
         return [_jsonable(v) for v in obj]
     if isinstance(obj, np.generic):
         return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if callable(obj):  # a Python law: named, not hashed (trade studies refuse it anyway)
+        return getattr(obj, "__qualname__", repr(obj))
     return obj
 
 
@@ -52,6 +56,9 @@ def study_settings(study: TradeStudy) -> dict:
         spec = _jsonable(study.controller)
         for k in ("name", "source"):  # labels only: they do not change the results
             spec.pop(k, None)
+        for k in ("linear", "gain", "python", "input_noise"):  # unset: ids as before them
+            if not spec.get(k):
+                spec.pop(k, None)
         s.update(
             controls=list(study.controls),
             sensors=list(study.sensors),

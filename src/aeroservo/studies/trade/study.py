@@ -52,7 +52,7 @@ from ...system.damping import NO_DAMPING, StructuralDamping
 
 __all__ = ["PARAMETERS", "METRICS", "FORMAT", "TradeStudy"]
 
-FORMAT = "aeroservo-trade/1"
+FORMAT = "aeroservo-trade/2"
 """Version of the case and study files; part of every case id."""
 
 PARAMETERS: dict[str, tuple[str, str]] = {
@@ -109,11 +109,24 @@ METRICS: dict[str, tuple[str, str]] = {
     "hinge_moment_saturation": ("-", "share of samples at the hinge-moment magnitude limit"),
     "tip_accel_peak": ("m/s^2", "peak |tip acceleration| in the 1-cos gust"),
     "tip_accel_rms": ("m/s^2", "RMS tip acceleration in the 1-cos gust"),
+    "closed_loop_lower_speed": (
+        "m/s",
+        "lower end of the closed loop's stable interval that holds the design speed",
+    ),
+    "gain_margin_db": (
+        "dB",
+        "gain margin at the first control at the design speed (loop broken at the actuator, "
+        "controller a black box)",
+    ),
+    "gain_reduction_margin_db": ("dB", "gain-reduction margin there (negative)"),
+    "phase_margin_deg": ("deg", "phase margin there"),
+    "disk_margin": ("-", "balanced disk margin alpha there"),
     "wall_time": ("s", "wall time of the case evaluation"),
 }
 """Numeric results of a case: name -> (unit, description)."""
 
-_LINEAR_TYPES = ("lqr", "lqg")
+_LINEAR_TYPES = ("lqr", "lqg", "mpc", "hinf", "linear", "gain")
+_BRYSON_TYPES = ("lqr", "lqg", "mpc", "hinf")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
@@ -151,8 +164,10 @@ class TradeStudy:
     gust_model : str
         Gust model of the plant: ``"kussner"`` or ``"upwash"``.
     controller : ControllerSpec or None
-        Linear controller (type ``"lqr"`` or ``"lqg"``; the closed-loop boundary needs a linear
-        loop). Needed unless ``closed_loop`` is False.
+        A controller with a linear law (type ``"lqr"``, ``"lqg"``, ``"mpc"`` (its law without
+        active constraints; the gust is flown with the MPC itself), ``"hinf"``, ``"linear"`` or
+        ``"gain"``; the closed-loop boundary needs a linear loop, so a Python law is refused).
+        Needed unless ``closed_loop`` is False.
     sample_rate : float
         Controller sample rate [Hz].
     parameters : dict
@@ -313,9 +328,14 @@ class TradeStudy:
             )
         if spec.type not in _LINEAR_TYPES:
             raise InputError(
-                f"controller.type = {spec.type!r}: a trade study needs a linear controller, "
-                f"one of {list(_LINEAR_TYPES)} (the closed-loop flutter boundary is an "
-                "eigenvalue analysis of the linear loop)"
+                f"controller.type = {spec.type!r}: a trade study needs a controller with a "
+                f"linear law, one of {list(_LINEAR_TYPES)} (the closed-loop flutter boundary is "
+                "an eigenvalue analysis of the linear loop)"
+            )
+        if "bryson_hinge_moment" in self.parameters and spec.type not in _BRYSON_TYPES:
+            raise InputError(
+                f"parameters.bryson_hinge_moment: the controller (type {spec.type!r}) is not "
+                "designed by Bryson's rule; it is the same in every case"
             )
         if "tip_accel" not in self.sensors + self.outputs:
             raise InputError(
