@@ -27,6 +27,7 @@ EXPECTED = {
     "04_trade_study.ipynb",
     "05_flutter_clearance.ipynb",
     "06_sensitivities_and_tailoring.ipynb",
+    "07_bring_your_own_controller.ipynb",
 }
 KERNEL = "python3"
 

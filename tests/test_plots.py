@@ -38,9 +38,14 @@ def test_margin_figures(tmp_path):
     ctrl = loop.design_controller(sc.controller, 1.1 * vf, sc.sample_rate, vf)
     m = loop_margins(loop.plant(1.1 * vf), ctrl)
     fig = plot_loop_margins(m, title=sc.name)
-    ax_n, ax_m, ax_p = fig.axes[:3]
+    ax_n, ax_m, ax_p, ax_s = fig.axes[:4]
     assert ax_n.get_xlabel() == "Re L" and ax_m.get_ylabel() == "|L| [dB]"
-    assert ax_p.get_xlabel() == "frequency [Hz]"
+    assert ax_s.get_xlabel() == "frequency [Hz]" and ax_s.get_ylabel() == "plant input [dB]"
+    # issue 24: S and T at the plant input with their peaks, and the break point named
+    s_labels = [t.get_text() for t in ax_s.get_legend().get_texts()]
+    assert any(t.startswith("|S = ") and "peak" in t for t in s_labels)
+    assert any(t.startswith("|T = ") for t in s_labels)
+    assert "black box" in fig.get_suptitle()
     labels = [t.get_text() for t in ax_m.get_legend().get_texts()]
     assert any("phase 62" in t for t in labels) and any("gain reduction" in t for t in labels)
     assert "requirement: 6 dB, 45 deg" in [t.get_text() for t in ax_n.get_legend().get_texts()]

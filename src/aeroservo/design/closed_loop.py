@@ -45,8 +45,9 @@ def linear_controller(controller, who: str, sample_rate: float | None = None):
     linear law (``who`` names the analysis in the message)."""
     ctrl = as_controller(controller, sample_rate=sample_rate)
     if not has_linear_law(ctrl):
+        what = getattr(controller, "name", None) or describe(controller)
         raise InputError(
-            f"{who}: controller = {describe(controller)} is not linear (a Python law or a "
+            f"{who}: controller = {what} is not linear (a Python law or a "
             "protocol object): it has no closed-loop eigenvalues or margins; simulate it, or "
             "bring its matrices (aeroservo.design.as_controller(control.ss(A, B, C, D, dt)))"
         )

@@ -97,7 +97,11 @@ class SimulationResult:
         for i, (c, cmd) in enumerate(self.commands.items()):
             peak = float(np.max(np.abs(cmd))) if np.all(np.isfinite(cmd)) else float("inf")
             if np.isfinite(mag[i]) and peak > ratio * mag[i]:
-                out[c] = {"peak_command": peak, "limit": float(mag[i]), "ratio": peak / mag[i]}
+                out[c] = {
+                    "peak_command": peak,
+                    "limit": float(mag[i]),
+                    "ratio": float(peak / mag[i]),
+                }
         return out
 
     def rate_limited_fraction(self) -> dict:
