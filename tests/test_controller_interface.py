@@ -182,9 +182,21 @@ def _similar(rng, Ac, Bc, Cc):
     return T @ Ac @ Ti, T @ Bc, Cc @ Ti
 
 
+def _parallel_pair(rng, Ac, Bc, Cc):
+    """A lightly damped pole pair (3-40 Hz, 0.5-5 % damping) added in parallel."""
+    f, zeta = rng.uniform(3.0, 40.0), rng.uniform(0.005, 0.05)
+    z = np.exp((-zeta + 1j * np.sqrt(1 - zeta**2)) * 2 * np.pi * f * DT)
+    Ae = np.array([[z.real, -z.imag], [z.imag, z.real]])
+    Be = rng.standard_normal((2, 3)) * np.abs(Bc).max(axis=0) * rng.uniform(0.002, 0.03)
+    Ce = rng.standard_normal((1, 2)) * np.abs(Cc).max()
+    return sla.block_diag(Ac, Ae), np.vstack([Bc, Be]), np.hstack([Cc, Ce])
+
+
 def random_compensator(rng, hinf, family: int):
-    """``(A, B, C, D)`` of a random compensator from the shipped H-infinity one (families 0 to
-    2), or of a random static gain ``u = D y`` (family 3)."""
+    """``(A, B, C, D)`` of a random compensator from the shipped H-infinity one, its gain and
+    sensors rescaled, its state transformed, and stable poles added: a filter in series on its
+    command (family 0), a lightly damped pair in parallel (1), both (2); or a random static
+    gain ``u = D y`` (family 3)."""
     Ac, Bc, Cc, Dc = (np.array(x, dtype=float) for x in hinf.compensator_matrices())
     if family == 3:
         K = rng.standard_normal((1, 3)) * np.array([1.0, 1.0, 1e4]) * np.exp(rng.uniform(-3, 3))
@@ -193,22 +205,20 @@ def random_compensator(rng, hinf, family: int):
     sens = np.exp(rng.uniform(-0.5, 0.5, size=3))
     Bc, Cc, Dc = Bc * sens, gain * Cc, gain * Dc * sens
     Ac, Bc, Cc = _similar(rng, Ac, Bc, Cc)
-    if family == 1:  # a lightly damped pole pair in parallel
-        f, zeta = rng.uniform(3.0, 40.0), rng.uniform(0.005, 0.05)
-        z = np.exp((-zeta + 1j * np.sqrt(1 - zeta**2)) * 2 * np.pi * f * DT)
-        Ae = np.array([[z.real, -z.imag], [z.imag, z.real]])
-        Be = rng.standard_normal((2, 3)) * np.abs(Bc).max(axis=0) * rng.uniform(0.002, 0.03)
-        Ce = rng.standard_normal((1, 2)) * np.abs(Cc).max()
-        return sla.block_diag(Ac, Ae), np.vstack([Bc, Be]), np.hstack([Cc, Ce]), Dc
-    return _series((Ac, Bc, Cc, Dc), _random_filter(rng))
+    if family >= 1:
+        Ac, Bc, Cc = _parallel_pair(rng, Ac, Bc, Cc)
+    if family != 1:
+        Ac, Bc, Cc, Dc = _series((Ac, Bc, Cc, Dc), _random_filter(rng))
+    return Ac, Bc, Cc, Dc
 
 
-def as_given(mats, family: int, i: int):
-    """The compensator in one of the forms the analyses accept."""
+def as_given(mats, family: int):
+    """The controller in one of the forms the analyses accept: a ``DiscreteCompensator``
+    (family 0), a python-control ``StateSpace`` (1, 2), a ``static_gain`` (3)."""
     A, B, C, D = mats
     if family == 3:
         return static_gain(-D, CONTROLS, sensors=SENSORS, sample_rate=RATE)
-    if i % 2:
+    if family:
         return control.ss(A, B, C, D, DT, inputs=list(SENSORS), outputs=list(CONTROLS))
     return DiscreteCompensator(A, B, C, D, CONTROLS, SENSORS, DT)
 
@@ -216,9 +226,10 @@ def as_given(mats, family: int, i: int):
 @pytest.mark.slow
 def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
     """20 random linear controllers on the Goland-with-aileron plant (the shipped H-infinity
-    compensator rescaled, its state transformed, random stable poles added in series or a
-    lightly damped pair in parallel; random static gains on the sensors), kept when stable at a
-    reference speed (1.1 V_f; 0.7 V_f for the static gains). ``closed_loop_boundary`` finds
+    compensator rescaled, its state transformed, random stable poles added: a filter in series,
+    a lightly damped pair in parallel or both; random static gains on the sensors), given as a
+    ``DiscreteCompensator``, a python-control ``StateSpace`` or a ``static_gain``, kept when
+    stable at a reference speed (1.1 V_f; 0.7 V_f for the static gains). ``closed_loop_boundary`` finds
     exactly the crossings of the reference (the dense eigenvalues of the closed sampled loop
     assembled here, on a 301-point grid, each sign change bisected to 1e-6 relative), each to
     1e-5 relative, with its kind and frequency, and the same stable intervals."""
@@ -241,7 +252,7 @@ def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
         g = np.array([ref.measure(v, mats) for v in speeds])
         expected = ref.crossings(mats, speeds, g)
         b = closed_loop_boundary(
-            loop, as_given(mats, family, i), v_max, v_min=v_min, n_grid=31, reference_speed=v_ref
+            loop, as_given(mats, family), v_max, v_min=v_min, n_grid=31, reference_speed=v_ref
         )
         found = [(c["speed"], c["kind"], c["frequency"]) for c in b.crossings]
         what = f"controller {i} (family {family}): found {found}, expected {expected}"
@@ -438,7 +449,9 @@ def plant(setup):
 
 
 @pytest.mark.parametrize("entry", ENTRY_POINTS)
-@pytest.mark.parametrize("obj", [o for _, o in NOT_CONTROLLERS], ids=[i for i, _ in NOT_CONTROLLERS])
+@pytest.mark.parametrize(
+    "obj", [o for _, o in NOT_CONTROLLERS], ids=[i for i, _ in NOT_CONTROLLERS]
+)
 def test_not_a_controller_is_an_input_error_everywhere(setup, plant, entry, obj):
     """Objects that are not controllers (an object, None, a string, a dict, a gain matrix or a
     function without signal names, python-control systems with unnamed signals or another
@@ -508,3 +521,514 @@ def test_a_nonlinear_law_is_simulated_but_refused_by_linear_analyses(setup, plan
     for entry in ("closed_loop_boundary", "closed_loop_matrix", "loop_margins", "judge_loop"):
         with pytest.raises(aes.InputError, match="not linear"):
             ENTRY_POINTS[entry](loop, plant, law)
+
+
+# -- 4. anti-windup -----------------------------------------------------------------------------
+
+
+def _integrator(plant, pole: float, anti_windup=None) -> DiscreteCompensator:
+    """Integral action on the tip twist, ``s+ = pole s + dt twist``, ``c = -(ki / G0) s``
+    (``G0`` the static twist per hinge moment, ki = 2 1/s); ``pole`` 1 is an integrator,
+    above 1 an unstable compensator pole."""
+    A, B = np.asarray(plant.A), np.asarray(plant.B)
+    row = list(plant.output_labels).index("tip_twist")
+    col = list(plant.input_labels).index(HM)
+    G0 = float(-(np.asarray(plant.C)[row] @ np.linalg.solve(A, B[:, col])))
+    return DiscreteCompensator(
+        [[pole]], [[0.0, 0.0, DT]], [[-2.0 / G0]], np.zeros((1, 3)), CONTROLS, SENSORS, DT,
+        anti_windup=anti_windup,
+    )  # fmt: skip
+
+
+def _steady_gust(t, speed):
+    """A steady 5 m/s vertical gust: a persistent twist the integrator cannot remove through a
+    tight hinge-moment limit."""
+    return np.full(np.shape(t), 5.0)
+
+
+@pytest.mark.parametrize("pole", [1.0, 1.0005], ids=["integrator", "unstable_pole"])
+def test_anti_windup_bounds_the_commands_and_leaves_the_linear_loop_alone(setup, pole):
+    """A compensator with an integrator (or an unstable pole) on the tip twist at 0.6 V_f, a
+    steady gust and a hinge-moment limit at a fifth of what would cancel it: with the default
+    anti-windup (``Ac - L Cc`` stable) the commands stay within twice the limit and
+    ``windup()`` is empty (no warning), also with a computational delay; with
+    ``anti_windup = 0`` the command runs away (``windup()`` reports it, ``simulate`` warns).
+    With the limits far away the responses with and without anti-windup are identical (1e-12),
+    with and without delay."""
+    _sc, loop, vf, _ = setup
+    plant = loop.plant(0.6 * vf)
+    comp = _integrator(plant, pole)
+    bare = _integrator(plant, pole, anti_windup=np.zeros((1, 1)))
+    L = comp.anti_windup
+    assert np.max(np.abs(np.linalg.eigvals(comp.Ac - L @ comp.Cc))) < 1.0
+    A, _ = closed_loop_matrix(plant, comp)
+    assert np.max(np.abs(np.linalg.eigvals(A))) < 1.0  # the linear loop is stable
+
+    # what the hinge moment must be to cancel the gust's twist (linear run, no limits)
+    free = simulate(plant, comp, duration=4.0, disturbance=_steady_gust)
+    need = abs(free.commands[HM][-1])
+    if pole == 1.0:  # integral action removes the twist
+        twist = free.outputs["tip_twist"]
+        assert abs(twist[-1]) < 1e-3 * np.max(np.abs(twist))
+    tight = Limits(magnitude={HM: 0.2 * need})
+    for delay in (False, True):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = simulate(
+                plant, comp, duration=4.0, disturbance=_steady_gust, limits=tight, delay=delay
+            )
+        assert r.windup() == {}
+        assert r.saturated_fraction()[HM] > 0.9
+        assert np.max(np.abs(r.commands[HM])) < 2 * 0.2 * need
+        with pytest.warns(RuntimeWarning, match="windup"):
+            w = simulate(
+                plant, bare, duration=4.0, disturbance=_steady_gust, limits=tight, delay=delay
+            )
+        wound = w.windup()
+        assert set(wound) == {HM} and wound[HM]["ratio"] > 10
+        cmd = np.abs(w.commands[HM])
+        assert cmd[-1] == np.max(cmd)  # still running away at the end
+
+    far = Limits(magnitude={HM: 1e9}, rate={HM: 1e12})
+    for delay in (False, True):
+        a, b = (
+            simulate(
+                plant, c, duration=2.0, disturbance=_steady_gust, limits=far, delay=delay,
+                record_states=True,
+            )
+            for c in (comp, bare)
+        )  # fmt: skip
+        assert np.array_equal(a.commands[HM], a.applied[HM])  # no limit acts
+        # identical but for the round-off of L (u - c) = L u - L c, u = c, over 2000 samples
+        for x, y, tol in (
+            (a.states, b.states, 1e-12),
+            (a.commands[HM], b.commands[HM], 1e-12),
+            *((a.outputs[n], b.outputs[n], 1e-11) for n in a.outputs),
+        ):
+            assert np.max(np.abs(x - y)) <= tol * np.max(np.abs(x))
+
+
+# -- 5. controller files: linear (.npz, .mat), gain, python -------------------------------------
+
+
+def save_npz(path, mats, dt, **change):
+    """A compensator saved the python-control way; ``change``: variables replaced (None: left
+    out)."""
+    A, B, C, D = mats
+    data = {"A": A, "B": B, "C": C, "D": D, "dt": dt}
+    data.update({"inputs": list(SENSORS), "outputs": list(CONTROLS)})
+    data.update(change)
+    np.savez(path, **{k: v for k, v in data.items() if v is not None})
+    return path
+
+
+def save_mat(path, mats, Ts, inputs=SENSORS, **change):
+    """A compensator saved the MATLAB way, ``save('k.mat', 'A', 'B', 'C', 'D', 'Ts',
+    'InputName', 'OutputName')``, the names as cell arrays; ``change`` as for
+    :func:`save_npz`."""
+    A, B, C, D = mats
+    data = {"A": A, "B": B, "C": C, "D": D, "Ts": float(Ts)}
+    data["InputName"] = np.array(list(inputs), dtype=object)
+    data["OutputName"] = np.array(list(CONTROLS), dtype=object)
+    data.update(change)
+    scipy.io.savemat(path, {k: v for k, v in data.items() if v is not None})
+    return path
+
+
+def linear_spec(file: str, **keys) -> str:
+    text = f'type = "linear"\nname = "brought"\nfile = "{file}"\n'
+    return text + "".join(f"{k} = {json.dumps(v)}\n" for k, v in keys.items())
+
+
+def inverse_tustin(mats, dt: float = DT):
+    """A continuous compensator whose Tustin discretisation at ``dt`` is ``mats``
+    (``z = (1 + s dt/2) / (1 - s dt/2)``; ``P = I + Ad``): ``A = (2/dt) P^-1 (Ad - I)``,
+    ``B = P^-1 Bd``, ``C = (4/dt) Cd P^-1``, ``D = Dd - Cd P^-1 Bd``."""
+    Ad, Bd, Cd, Dd = mats
+    n = Ad.shape[0]
+    Pi = np.linalg.inv(np.eye(n) + Ad)
+    return (2 / dt) * Pi @ (Ad - np.eye(n)), Pi @ Bd, (4 / dt) * Cd @ Pi, Dd - Cd @ Pi @ Bd
+
+
+def discrete_response(mats, f: np.ndarray, dt: float = DT) -> np.ndarray:
+    """``C (zI - A)^-1 B + D`` at ``z = exp(j 2 pi f dt)``, shape ``(len(f), m, p)``."""
+    A, B, C, D = mats
+    z = np.exp(2j * np.pi * f * dt)
+    n = A.shape[0]
+    return np.array([C @ np.linalg.solve(zk * np.eye(n) - A, B) + D for zk in z])
+
+
+def continuous_response(mats, f: np.ndarray) -> np.ndarray:
+    A, B, C, D = mats
+    n = A.shape[0]
+    return np.array([C @ np.linalg.solve(2j * np.pi * fk * np.eye(n) - A, B) + D for fk in f])
+
+
+FREQS = np.array([0.5, 2.0, 7.0, 11.0, 13.0, 25.0, 49.0, 120.0, 400.0])  # Hz, below Nyquist
+
+
+def assert_same_numbers(a, b, rel: float, path: str = "") -> None:
+    """Two JSON-like trees hold the same numbers (to ``rel``) and the same other values; the
+    ``law`` entries (what the controller is called) are not compared."""
+    if isinstance(a, dict):
+        assert set(a) == set(b), path
+        for k in a:
+            if k != "law":
+                assert_same_numbers(a[k], b[k], rel, f"{path}.{k}")
+    elif isinstance(a, (list, tuple)):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            assert_same_numbers(x, y, rel, f"{path}[{i}]")
+    elif isinstance(a, float) and not isinstance(b, bool):
+        assert b == pytest.approx(a, rel=rel, abs=1e-12), path
+    else:
+        assert a == b, path
+
+
+@pytest.fixture(scope="module")
+def builtin_hinf_run():
+    """The shipped H-infinity scenario, quick settings."""
+    return run_simulation(quick(load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml")))
+
+
+def _brought(path):
+    """The controller a scenario's controller file brings (at the scenario's loop)."""
+    sc = quick(load_scenario(path))
+    loop = sc.loop()
+    return sc, loop.design_controller(sc.controller, 100.0, sc.sample_rate, VF)
+
+
+def test_brought_hinf_gives_the_margins_and_boundary_of_the_builtin_one(
+    setup, builtin_hinf_run, tmp_path
+):
+    """The shipped H-infinity compensator saved to a ``.npz`` (python-control's way) and to a
+    ``.mat`` (MATLAB's: ``Ts``, ``InputName``/``OutputName`` cell arrays) and brought by a
+    controller file of type ``linear``: the scenario runs give the same margins, closed-loop
+    boundary, engaged-range judgement and time histories as the built-in design (1e-9); saved
+    continuous (``Ts = 0``, the inverse Tustin map) and brought with ``method = "tustin"`` it is
+    the same compensator (frequency response 1e-9) with the same boundary and margins (1e-6)."""
+    _sc, _loop, _vf, hinf = setup
+    mats = hinf.compensator_matrices()
+    ref = builtin_hinf_run
+    save_npz(tmp_path / "k.npz", mats, DT)
+    save_mat(tmp_path / "k.mat", mats, DT)
+    save_mat(tmp_path / "kc.mat", inverse_tustin(mats), 0.0)
+    H = discrete_response(mats, FREQS)
+    for i, (file, rel) in enumerate((("k.npz", 1e-9), ("k.mat", 1e-9), ("kc.mat", 1e-6))):
+        spec = linear_spec(f"../../{file}", method="tustin")
+        path = scenario_copy(tmp_path / f"s{i}", "goland_aileron_hinf", controller=spec)
+        _, brought = _brought(path)
+        assert brought.info["continuous"] is (file == "kc.mat")
+        Hb = discrete_response(brought.compensator_matrices(), FREQS)
+        assert np.max(np.abs(Hb - H)) <= 1e-9 * np.max(np.abs(H))
+        run = run_simulation(quick(load_scenario(path)))
+        s = run.summary
+        assert s["controller_type"] == "linear" and s["verdict"] == "stable" and s["passed"]
+        for key in ("margins", "closed_loop", "engaged", "margin_sweep"):
+            assert_same_numbers(ref.summary[key], s[key], rel, key)
+        for name, y in ref.simulation.outputs.items():
+            y2 = run.simulation.outputs[name]
+            assert np.max(np.abs(y2 - y)) <= rel * np.max(np.abs(y)), name
+
+
+def _own_zoh(mats, dt: float = DT):
+    """The compensator discretised by a zero-order hold written here."""
+    A, B, C, D = mats
+    n, p = B.shape
+    M = np.zeros((n + p, n + p))
+    M[:n, :n], M[:n, n:] = A, B
+    E = sla.expm(M * dt)
+    return E[:n, :n], E[:n, n:], C, D
+
+
+def _tustin_response(cont, f: np.ndarray, prewarp: float | None = None, dt: float = DT):
+    """The response at ``f`` [Hz] of the Tustin discretisation of a continuous compensator:
+    the continuous response at ``c tan(pi f dt)`` [rad/s], ``c = 2 / dt`` (or
+    ``w0 / tan(w0 dt / 2)``, exact at the prewarp frequency ``w0``)."""
+    c = 2 / dt if prewarp is None else 2 * np.pi * prewarp / np.tan(np.pi * prewarp * dt)
+    return continuous_response(cont, c * np.tan(np.pi * f * dt) / (2 * np.pi))
+
+
+def test_continuous_compensator_is_discretised_by_the_method_of_its_file(setup, tmp_path):
+    """A continuous compensator (``dt = 0`` in a ``.npz``, ``Ts = 0`` in a ``.mat``) is
+    discretised at the loop's rate by the file's ``method``: ``zoh`` gives the zero-order hold
+    computed here, ``tustin`` (the default) the bilinear map, with ``prewarp`` exact at that
+    frequency (frequency responses to 1e-9); ``sign = -1`` negates the output; MATLAB's
+    ``Ts = -1`` (unspecified) is discrete at the loop's period; ``anti_windup = false`` sets
+    the anti-windup gain to zero."""
+    _sc, _loop, _vf, hinf = setup
+    mats = hinf.compensator_matrices()
+    cont = inverse_tustin(mats)
+    H = discrete_response(mats, FREQS)
+    # the inverse map is right: its Tustin image is the H-infinity compensator
+    assert np.max(np.abs(_tustin_response(cont, FREQS) - H)) <= 1e-9 * np.max(np.abs(H))
+    A, B, C, D = cont
+    save_npz(tmp_path / "c.npz", cont, 0.0)
+    save_npz(tmp_path / "neg.npz", (A, B, -C, -D), 0.0)
+    save_mat(tmp_path / "c.mat", cont, 0.0)
+    save_mat(tmp_path / "free.mat", mats, -1.0)
+    zoh = discrete_response(_own_zoh(cont), FREQS)
+    cases = [
+        ("c.npz", {"method": "zoh"}, zoh),
+        ("c.mat", {"method": "zoh"}, zoh),
+        ("c.npz", {}, H),
+        ("neg.npz", {"sign": -1}, H),
+        ("c.mat", {"method": "tustin", "prewarp": 11.0}, _tustin_response(cont, FREQS, 11.0)),
+        ("free.mat", {"anti_windup": False}, H),
+    ]
+    for file, keys, expected in cases:
+        spec = linear_spec(f"../../{file}", **keys)
+        path = scenario_copy(tmp_path / "s", "goland_aileron_hinf", controller=spec)
+        _, brought = _brought(path)
+        got = discrete_response(brought.compensator_matrices(), FREQS)
+        assert np.max(np.abs(got - expected)) <= 1e-9 * np.max(np.abs(expected)), (file, keys)
+        assert brought.dt == DT
+        assert bool(np.any(brought.anti_windup)) is ("anti_windup" not in keys), (file, keys)
+        if "prewarp" in keys:  # exact at the prewarp frequency
+            f0 = np.array([keys["prewarp"]])
+            Hc = continuous_response(cont, f0)
+            Hd = discrete_response(brought.compensator_matrices(), f0)
+            assert np.max(np.abs(Hd - Hc)) <= 1e-9 * np.max(np.abs(Hc))
+
+
+TWIST_GAIN = [[-0.5, -0.5, 2.0e4]]  # N m per (m/s^2, m/s^2, rad): u = -K y
+LAW_PY = """\
+K = {K}
+
+
+def law(t, y):
+    \"\"\"A twist and acceleration feedback, u = -K y.\"\"\"
+    return [-sum(k * v for k, v in zip(K[0], y))]
+"""
+
+
+def test_gain_and_python_controller_files_run_in_a_scenario(setup, tmp_path):
+    """A controller file of type ``gain`` (``u = -K y`` on named sensors) and one of type
+    ``python`` (a function in a ``.py`` file computing the same law) run in the H-infinity
+    scenario at 0.8 V_f: the gain's loop has the spectral radius of the reference loop
+    assembled here (1e-12) and is judged by its eigenvalues and margins; the Python law is
+    simulated (the same time histories as the gain, 1e-9), judged by time marching across the
+    engaged range, and has no margins."""
+    _sc, loop, vf, _ = setup
+    gain = (
+        'type = "gain"\nname = "twist gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+        f"sensors = {json.dumps(list(SENSORS))}\nmatrix = {json.dumps(TWIST_GAIN)}\n"
+    )
+    (tmp_path / "law.py").write_text(LAW_PY.format(K=TWIST_GAIN))
+    python = 'type = "python"\nname = "law"\nfile = "../../law.py"\nfunction = "law"\n'
+    runs = {}
+    for kind, text in (("gain", gain), ("python", python)):
+        path = scenario_copy(
+            tmp_path / kind,
+            "goland_aileron_hinf",
+            ("speed_factor = 1.1", "speed_factor = 0.8"),
+            controller=text,
+        )
+        runs[kind] = run_simulation(quick(load_scenario(path)))
+    g, p = runs["gain"].summary, runs["python"].summary
+    assert g["controller_type"] == "gain" and p["controller_type"] == "python"
+    speed = g["speed"]
+    assert speed == pytest.approx(0.8 * vf, rel=1e-9)
+    mats = (np.zeros((0, 0)), np.zeros((0, 3)), np.zeros((1, 0)), -np.array(TWIST_GAIN))
+    rho = 1.0 + SampledReference(loop).measure(speed, mats)
+    assert g["spectral_radius"] == pytest.approx(rho, rel=1e-12) and rho < 1.0
+    assert g["verdict"] == "stable" and "margins" in g and "margin_sweep" in g
+    assert p["spectral_radius"] is None and "margins" not in p
+    assert "time marching" in p["engaged"]["method"]
+    assert p["engaged"]["margins_over_range"]["meets"] is None
+    gs, ps = runs["gain"].simulation, runs["python"].simulation
+    hm = gs.applied[HM]
+    assert np.max(np.abs(hm)) > 10.0  # the law acts
+    assert np.max(np.abs(ps.applied[HM] - hm)) <= 1e-9 * np.max(np.abs(hm))
+    for name, y in gs.outputs.items():
+        assert np.max(np.abs(ps.outputs[name] - y)) <= 1e-9 * np.max(np.abs(y)), name
+
+
+def _fake_v73(path):
+    """The 128-byte header of a MATLAB v7.3 (HDF5) file and the HDF5 signature."""
+    text = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Jun 24 12:00:00 2024 HDF5"
+    path.write_bytes(text.ljust(116, b" ") + b"\0" * 8 + b"\0\2IM" + b"\x89HDF\r\n\x1a\n")
+    return path
+
+
+def _bad_files(tmp_path, mats):
+    """``(controller file text, words the error must hold)`` for bad brought controllers."""
+    A, B, C, D = mats
+    n = A.shape[0]
+    save_npz(tmp_path / "no_b.npz", mats, DT, B=None)
+    save_npz(tmp_path / "shape.npz", mats, DT, B=B[:-1])
+    save_npz(tmp_path / "text.npz", mats, DT, A=np.array([["a"] * n] * n))
+    save_npz(tmp_path / "unnamed.npz", mats, DT, inputs=None)
+    save_mat(tmp_path / "unnamed.mat", mats, DT, OutputName=None)
+    save_mat(tmp_path / "count.mat", mats, DT, inputs=SENSORS[:2])
+    save_mat(tmp_path / "ts.mat", mats, -0.5)
+    save_npz(tmp_path / "ok.npz", mats, DT)
+    _fake_v73(tmp_path / "v73.mat")
+    (tmp_path / "k.txt").write_text("A = 1\n")
+    return [
+        (linear_spec("no_b.npz"), ["no_b.npz", "file = ", "variable B is missing"]),
+        (linear_spec("shape.npz"), ["shape.npz", "variable B has shape", f"({n - 1}, 3)"]),
+        (linear_spec("text.npz"), ["text.npz", "variable A"]),
+        (linear_spec("unnamed.npz"), ["unnamed.npz", "inputs have no names", "InputName"]),
+        (linear_spec("unnamed.mat"), ["unnamed.mat", "outputs have no names", "OutputName"]),
+        (linear_spec("count.mat"), ["count.mat", "InputName has 2 names; D has 3 inputs"]),
+        (linear_spec("ts.mat"), ["ts.mat", "Ts = -0.5"]),
+        (linear_spec("v73.mat"), ["v73.mat", "v7.3", "-v7"]),
+        (linear_spec("k.txt"), ["k.txt", "expected a .npz or .mat file"]),
+        (linear_spec("missing.npz"), ["missing.npz", "no such file"]),
+        (linear_spec("ok.npz", method="euler"), ["method = 'euler'", "tustin"]),
+        (linear_spec("ok.npz", sign=0), ["sign"]),
+        (linear_spec("ok.npz", function="f"), ["function", "not used by a controller of type"]),
+        ('type = "linear"\n', ["file", "missing"]),
+        (
+            'type = "gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+            'sensors = ["tip_twist"]\nmatrix = [[1.0, 2.0]]\n',
+            ["gain.matrix", "row 0: expected 1 numbers"],
+        ),
+        (
+            'type = "gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\nmatrix = [[1.0]]\n',
+            ["gain.sensors", "give sensors or states"],
+        ),
+        ('type = "python"\nfile = "law.py"\nfunction = "law"\n', ["file", "law.py"]),
+        ('type = "python"\nfile = "ok.npz"\n', ["function", "missing"]),
+    ]
+
+
+def test_bad_controller_files_are_one_line_input_errors(setup, tmp_path):
+    """Bad brought controllers (a variable missing, of the wrong shape or not numeric, signal
+    names missing or miscounted, a negative sample time, a MATLAB v7.3 file, a file that is
+    neither .npz nor .mat or does not exist, an unknown method, a bad sign, a key another type
+    uses, a gain matrix of the wrong width, a Python file that does not exist) are refused when
+    the controller file is read, by a one-line ``InputError`` naming the controller file, the
+    data file and the variable or key at fault."""
+    from aeroservo.files import load_controller
+
+    for i, (text, words) in enumerate(_bad_files(tmp_path, setup[3].compensator_matrices())):
+        path = tmp_path / f"bad{i}.toml"
+        path.write_text(text)
+        with pytest.raises(aes.InputError) as info:
+            load_controller(path)
+        message = str(info.value)
+        assert "\n" not in message and f"bad{i}.toml" in message, message
+        for w in words:
+            assert w in message, (w, message)
+
+
+def test_brought_compensator_errors_at_design_name_the_controller_file(setup, tmp_path):
+    """A discrete compensator saved at another sample period than the loop's, a prewarp with
+    the ``zoh`` method, signal names the loop does not have, and the matched pole-zero method
+    for a compensator of three sensors are refused when the scenario's controller is brought,
+    naming the controller file."""
+    mats = setup[3].compensator_matrices()
+    save_npz(tmp_path / "slow.npz", mats, 2 * DT)
+    save_npz(tmp_path / "cont.npz", inverse_tustin(mats), 0.0)
+    save_npz(tmp_path / "yaw.npz", mats, DT, inputs=["tip_le_accel", "tip_te_accel", "tip_yaw"])
+    for i, (text, words) in enumerate(
+        (
+            (linear_spec("../../slow.npz"), ["period 0.002 s", "discretise it again"]),
+            (linear_spec("../../cont.npz", method="zoh", prewarp=10.0), ["prewarp", "zoh"]),
+            (linear_spec("../../yaw.npz"), ["tip_yaw"]),
+            (linear_spec("../../cont.npz", method="matched"), ["matched", "SISO"]),
+        )
+    ):
+        path = scenario_copy(tmp_path / f"s{i}", "goland_aileron_hinf", controller=text)
+        with pytest.raises(aes.InputError) as info:
+            _brought(path)
+        message = str(info.value)
+        assert "\n" not in message and "brought.toml" in message, message
+        for w in words:
+            assert w in message, (w, message)
+
+
+# -- bugs found while writing these tests (xfail until fixed) -----------------------------------
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        pytest.param({"dt": "fast"}, id="text_sample_time"),
+        pytest.param({"dt": np.array([])}, id="empty_sample_time"),
+        pytest.param({"A": np.eye(1) * (0.5 + 0.1j)}, id="complex_matrix"),
+    ],
+)
+@pytest.mark.xfail(
+    strict=True,
+    raises=(ValueError, IndexError, np.exceptions.ComplexWarning),
+    reason="bug: read_linear_controller lets a non-numeric or empty sample time through as a "
+    "ValueError/IndexError, and casts complex matrices to real (ComplexWarning)",
+)
+def test_bad_numbers_in_a_compensator_file_are_input_errors(tmp_path, change):
+    """A sample time that is text or empty, or a complex matrix, in a compensator file is an
+    ``InputError`` naming the file and the variable (not a ValueError or IndexError, and not a
+    complex matrix silently made real)."""
+    from aeroservo.files.linear_controller import read_linear_controller
+
+    mats = (np.eye(1) * 0.5, np.ones((1, 3)), np.ones((1, 1)), np.zeros((1, 3)))
+    key = next(iter(change))
+    change = dict(change)
+    path = save_npz(tmp_path / "k.npz", mats, change.pop("dt", DT), **change)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(aes.InputError, match=f"k.npz: .*{key}"):
+            read_linear_controller(path)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=scipy.io.matlab.MatReadError,
+    reason="bug: an empty or truncated .mat file raises scipy's MatReadError",
+)
+def test_truncated_mat_file_is_an_input_error(tmp_path):
+    """An empty (or truncated) ``.mat`` file is an ``InputError`` naming it, as a ``.mat``
+    file of an unknown version is."""
+    from aeroservo.files.linear_controller import read_linear_controller
+
+    (tmp_path / "k.mat").write_bytes(b"")
+    with pytest.raises(aes.InputError, match="k.mat"):
+        read_linear_controller(tmp_path / "k.mat")
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=(ValueError, TypeError),
+    reason="bug: simulate does not check the commands of a protocol controller (ValueError or "
+    "numpy's UFuncTypeError from the time march), as it does those of a python_law",
+)
+@pytest.mark.parametrize("out", [np.zeros(2), "abc"], ids=["two_commands", "text"])
+def test_protocol_controller_returning_bad_commands_is_an_input_error(setup, plant, out):
+    """A protocol object whose ``command`` returns the wrong number of commands, or text, is
+    refused by ``simulate`` with an ``InputError``, as a ``python_law`` returning them is."""
+    bad = Protocol()
+    bad.command = lambda y, x=None: out
+    with pytest.raises(aes.InputError):
+        simulate(plant, bad, duration=0.01)
+
+
+class ScheduleLike:
+    """A gain schedule written by a user: ``at(speed)`` returns a python-control compensator."""
+
+    dt = DT
+    controls = CONTROLS
+
+    def at(self, speed):
+        return control.ss(
+            [[0.5]], [[0.0, 0.0, 1.0]], [[1.0]], [[0.0, 0.0, 0.0]], DT,
+            inputs=list(SENSORS), outputs=list(CONTROLS),
+        )  # fmt: skip
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=AttributeError,
+    reason="bug: an object with at() passes as_controller as a schedule, but what at() returns "
+    "is not passed through as_controller: AttributeError in simulate and closed_loop_matrix",
+)
+@pytest.mark.parametrize("entry", ["simulate", "closed_loop_matrix"])
+def test_schedule_like_object_is_accepted_or_refused_with_an_input_error(setup, plant, entry):
+    """A schedule-like object (``dt``, ``controls`` and ``at(speed)`` returning a
+    python-control compensator) is either run through ``as_controller`` at the speed or
+    refused with an ``InputError``; never an AttributeError."""
+    try:
+        ENTRY_POINTS[entry](setup[1], plant, ScheduleLike())
+    except aes.InputError:
+        pass

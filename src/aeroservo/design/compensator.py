@@ -159,6 +159,22 @@ class DiscreteCompensator:
         self.s = self.Ac @ self.s + self.Bc @ y + self.anti_windup @ (u - self._c)
 
 
+def sample_period(sample_rate: float | None) -> float | None:
+    """The loop's sample period [s] from its sample rate [Hz] (None stays None)."""
+    if sample_rate is None:
+        return None
+    return 1.0 / check_number("sample_rate", sample_rate, unit="Hz", lo=1.0, hi=1e5)
+
+
+def check_period(dt: float, dt_loop: float | None, what: str) -> None:
+    """A discrete controller's period ``dt`` [s] must be the loop's (if the loop's is given)."""
+    if dt_loop is not None and abs(dt - dt_loop) > 1e-9 * dt_loop:
+        raise InputError(
+            f"{what} is discrete with period {dt:g} s ({1 / dt:g} Hz); the loop samples at "
+            f"{1 / dt_loop:g} Hz: discretise it again at that rate"
+        )
+
+
 def _names(sys, kind: str, given) -> list[str]:
     """The input (``kind="inputs"``) or output names of an LTI system, or the given ones."""
     labels = list(sys.input_labels if kind == "inputs" else sys.output_labels)
@@ -229,9 +245,7 @@ def compensator_from_lti(
     if method not in DISCRETIZATIONS:
         raise InputError(f"method = {describe(method)}: choose one of {list(DISCRETIZATIONS)}")
     sensor_names, control_names = _names(sys, "inputs", sensors), _names(sys, "outputs", controls)
-    dt_loop = None
-    if sample_rate is not None:
-        dt_loop = 1.0 / check_number("sample_rate", sample_rate, unit="Hz", lo=1.0, hi=1e5)
+    dt_loop = sample_period(sample_rate)
     info = {"source": source or type(sys).__name__}
     if sys.dt in (0, None):  # continuous
         if dt_loop is None:
@@ -266,11 +280,7 @@ def compensator_from_lti(
             dt = dt_loop
         else:
             dt = float(sys.dt)
-            if dt_loop is not None and abs(dt - dt_loop) > 1e-9 * dt_loop:
-                raise InputError(
-                    f"the compensator is discrete with period {dt:g} s ({1 / dt:g} Hz); the "
-                    f"loop samples at {1 / dt_loop:g} Hz: discretise it again at that rate"
-                )
+            check_period(dt, dt_loop, "the compensator")
         info.update(continuous=False)
     A, B, C, D = (np.asarray(x, dtype=float) for x in (d.A, d.B, d.C, d.D))
     return DiscreteCompensator(

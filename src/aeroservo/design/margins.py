@@ -193,7 +193,9 @@ def _multiloop(A, B, C, theta: np.ndarray, dt: float, channels: dict) -> tuple[d
         peak, t_peak = vals[i], theta[i]
         lo, hi = theta[max(i - 1, 0)], theta[min(i + 1, theta.size - 1)]
         if hi > lo:
-            res = so.minimize_scalar(lambda t: -mu(t), bounds=(lo, hi), method="bounded")
+            res = so.minimize_scalar(
+                lambda t: -mu(t), bounds=(lo, hi), method="bounded", options={"xatol": 1e-13}
+            )
             if -res.fun > peak:
                 peak, t_peak = -res.fun, float(res.x)
         alpha, f = float(1.0 / peak), float(t_peak * hz)

@@ -50,7 +50,12 @@ class SimulatedJudgement:
         if self.stable:
             return []
         at = ", ".join(f"{v:.4g} m/s ({', '.join(g[:2])} grow)" for v, g in self.growing.items())
-        return [f"closed loop unstable in the engaged range {self.engaged.text()}: at {at}"]
+        e = self.engaged
+        return [
+            f"closed loop unstable between {e.low:.4g} m/s and {e.flutter_margin:g} x "
+            f"{e.high:.4g} = {e.stable_to:.4g} m/s (engaged range and flutter margin), "
+            f"simulated: at {at}"
+        ]
 
     def to_dict(self) -> dict:
         return {
@@ -95,12 +100,13 @@ class LoopAnalysis:
 
 
 def _simulated(scenario: Scenario, loop, controller, engaged, x0, bar) -> SimulatedJudgement:
-    """Time marching at ``scenario.margin_speeds`` speeds (at least 3) across the range."""
+    """Time marching at ``scenario.margin_speeds`` speeds (at least 3) from the bottom of the
+    range to its flutter margin."""
     from ..simulate.march import simulate
 
-    speeds = np.linspace(engaged.low, engaged.high, max(scenario.margin_speeds, 3))
+    speeds = np.linspace(engaged.low, engaged.stable_to, max(scenario.margin_speeds, 3))
     out = SimulatedJudgement(engaged, speeds)
-    update, close = bar(engaged.high, "engaged range")
+    update, close = bar(engaged.stable_to, "engaged range")
     try:
         for v in speeds:
             sim = simulate(
