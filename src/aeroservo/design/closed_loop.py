@@ -40,6 +40,12 @@ def _controller_at(controller, speed: float):
     return controller.at(speed) if hasattr(controller, "at") else controller
 
 
+def plant_function(plant_at) -> Callable[[float], object]:
+    """``V -> control.StateSpace`` from a ControlLoop (its ``plant``), a StateSpaceBuilder (its
+    ``at``) or such a function."""
+    return getattr(plant_at, "at", None) or getattr(plant_at, "plant", None) or plant_at
+
+
 def linear_controller(controller, who: str, sample_rate: float | None = None):
     """The controller through :func:`~aeroservo.design.as_controller`, refused unless it has a
     linear law (``who`` names the analysis in the message)."""
@@ -185,7 +191,7 @@ def closed_loop_boundary(
     v_min = check_number("v_min", v_min, unit="m/s", lo=0.0, hi=v_max, lo_open=True, hi_open=True)
     n_grid = check_int("n_grid", n_grid, lo=3, hi=10_000)
     check_number("rtol", rtol, lo=0.0, hi=1e-2, lo_open=True)
-    at = getattr(plant_at, "at", None) or getattr(plant_at, "plant", None) or plant_at
+    at = plant_function(plant_at)
     if reference_speed is None:
         reference_speed = getattr(controller, "design_speed", None)
         if reference_speed is None or not np.isfinite(reference_speed):

@@ -275,8 +275,13 @@ def judge_loop(
         speeds = np.linspace(engaged.low, engaged.high, margin_speeds)
         if engaged.low <= ref <= engaged.high:
             speeds = np.unique(np.r_[speeds, ref])
-        at = getattr(plant_at, "at", None) or getattr(plant_at, "plant", None) or plant_at
         sweep = margins_over_speed(
-            at, ctrl, speeds, delay=delay, requirement=req, reference_speed=ref, progress=progress
+            plant_at,
+            ctrl,
+            speeds,
+            delay=delay,
+            requirement=req,
+            reference_speed=ref,
+            progress=progress,
         )
     return LoopJudgement(engaged, b, unstable, sweep, req)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .closed_loop import plant_function
 from .margins import LoopMargins, MarginRequirement, loop_margins
 
 __all__ = ["MarginSweep", "margins_over_speed", "QUANTITIES"]
@@ -112,8 +113,9 @@ def margins_over_speed(
 
     Parameters
     ----------
-    plant_at : StateSpaceBuilder or callable
-        The plant at a speed (its ``at``, or ``V -> control.StateSpace``, filters included).
+    plant_at : ControlLoop, StateSpaceBuilder or callable
+        The plant at a speed (its ``plant``, its ``at``, or ``V -> control.StateSpace``, filters
+        included).
     controller
         Linear sampled controller or gain schedule.
     speeds : sequence of float
@@ -126,7 +128,7 @@ def margins_over_speed(
     progress : callable, optional
         Called with each speed [m/s].
     """
-    at = plant_at.at if hasattr(plant_at, "at") else plant_at
+    at = plant_function(plant_at)
     req = requirement or MarginRequirement()
     v = np.asarray(speeds, dtype=float)
     out: list[LoopMargins] = []
