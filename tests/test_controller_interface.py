@@ -940,7 +940,7 @@ def test_brought_compensator_errors_at_design_name_the_controller_file(setup, tm
             assert w in message, (w, message)
 
 
-# -- bugs found while writing these tests (xfail until fixed) -----------------------------------
+# -- bugs found while writing these tests (fixed in src) ----------------------------------------
 
 
 @pytest.mark.parametrize(
@@ -950,12 +950,6 @@ def test_brought_compensator_errors_at_design_name_the_controller_file(setup, tm
         pytest.param({"dt": np.array([])}, id="empty_sample_time"),
         pytest.param({"A": np.eye(1) * (0.5 + 0.1j)}, id="complex_matrix"),
     ],
-)
-@pytest.mark.xfail(
-    strict=True,
-    raises=(ValueError, IndexError, np.exceptions.ComplexWarning),
-    reason="bug: read_linear_controller lets a non-numeric or empty sample time through as a "
-    "ValueError/IndexError, and casts complex matrices to real (ComplexWarning)",
 )
 def test_bad_numbers_in_a_compensator_file_are_input_errors(tmp_path, change):
     """A sample time that is text or empty, or a complex matrix, in a compensator file is an
@@ -973,11 +967,6 @@ def test_bad_numbers_in_a_compensator_file_are_input_errors(tmp_path, change):
             read_linear_controller(path)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=scipy.io.matlab.MatReadError,
-    reason="bug: an empty or truncated .mat file raises scipy's MatReadError",
-)
 def test_truncated_mat_file_is_an_input_error(tmp_path):
     """An empty (or truncated) ``.mat`` file is an ``InputError`` naming it, as a ``.mat``
     file of an unknown version is."""
@@ -988,12 +977,6 @@ def test_truncated_mat_file_is_an_input_error(tmp_path):
         read_linear_controller(tmp_path / "k.mat")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=(ValueError, TypeError),
-    reason="bug: simulate does not check the commands of a protocol controller (ValueError or "
-    "numpy's UFuncTypeError from the time march), as it does those of a python_law",
-)
 @pytest.mark.parametrize("out", [np.zeros(2), "abc"], ids=["two_commands", "text"])
 def test_protocol_controller_returning_bad_commands_is_an_input_error(setup, plant, out):
     """A protocol object whose ``command`` returns the wrong number of commands, or text, is
@@ -1017,12 +1000,6 @@ class ScheduleLike:
         )  # fmt: skip
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AttributeError,
-    reason="bug: an object with at() passes as_controller as a schedule, but what at() returns "
-    "is not passed through as_controller: AttributeError in simulate and closed_loop_matrix",
-)
 @pytest.mark.parametrize("entry", ["simulate", "closed_loop_matrix"])
 def test_schedule_like_object_is_accepted_or_refused_with_an_input_error(setup, plant, entry):
     """A schedule-like object (``dt``, ``controls`` and ``at(speed)`` returning a

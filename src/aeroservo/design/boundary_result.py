@@ -185,7 +185,13 @@ class ClosedLoopBoundary:
             "v_range": list(self.v_range),
         }
 
-    def plot(self, ax=None, open_loop=None, engaged: tuple[float, float] | None = None):
+    def plot(
+        self,
+        ax=None,
+        open_loop=None,
+        engaged: tuple[float, float] | None = None,
+        stable_to: float | None = None,
+    ):
         """Growth rate of the least stable pole versus speed; each loss of stability named by
         its kind, the lower end of the stable interval and the engaged range marked.
 
@@ -196,6 +202,8 @@ class ClosedLoopBoundary:
             Adds the open-loop tracked modes' real parts for comparison.
         engaged : (float, float), optional
             Speed range [m/s] where the loop is engaged (shaded).
+        stable_to : float, optional
+            Speed [m/s] up to which stability is required (the flutter margin), marked.
         """
         from matplotlib.figure import Figure
 
@@ -206,6 +214,8 @@ class ClosedLoopBoundary:
             fig = ax.figure
         if engaged is not None:
             ax.axvspan(*engaged, color="g", alpha=0.08, label="engaged range")
+        if stable_to is not None:
+            ax.axvline(stable_to, color="g", ls=":", lw=1, label="stability required to")
         if open_loop is not None:
             ol = np.max(open_loop.eigenvalues.real, axis=1)
             ax.plot(open_loop.speeds, ol, color="0.6", lw=1, label="open loop (tracked modes)")
@@ -236,5 +246,5 @@ class ClosedLoopBoundary:
         ax.set_xlabel("airspeed V [m/s]")
         ax.set_ylabel("growth rate of least stable pole [1/s]")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7, loc="lower left")
+        ax.legend(fontsize=7, loc="upper left")
         return fig

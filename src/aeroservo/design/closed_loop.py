@@ -27,17 +27,12 @@ from ..errors import InputError, check_int, check_number
 from ..linear.signals import describe
 from ..stability.boundary import sign_changes
 from .boundary_result import ClosedLoopBoundary
-from .interface import as_controller, has_linear_law
+from .interface import as_controller, controller_at, has_linear_law
 from .law import pad_state_map
 from .plant import SampledPlant, select
 from .sampled_loop import linear_law, loop_matrix, plant_states
 
 __all__ = ["ClosedLoopBoundary", "closed_loop_boundary", "closed_loop_matrix"]
-
-
-def _controller_at(controller, speed: float):
-    """The linear controller in force at ``speed`` (a schedule is evaluated there)."""
-    return controller.at(speed) if hasattr(controller, "at") else controller
 
 
 def plant_function(plant_at) -> Callable[[float], object]:
@@ -99,7 +94,7 @@ def closed_loop_matrix(
     import control
 
     controller = linear_controller(controller, "closed_loop_matrix", sample_rate)
-    controller = _controller_at(controller, float(getattr(plant, "speed", np.nan)))
+    controller = controller_at(controller, float(getattr(plant, "speed", np.nan)))
     controls = list(controller.controls)
     if sampled:
         law = linear_law(controller, plant_states(plant))
@@ -208,7 +203,7 @@ def closed_loop_boundary(
         if v in known:
             return known[v]
         n_eval[0] += 1
-        ctrl = _controller_at(controller, v)
+        ctrl = controller_at(controller, v)
         if cached is not None:  # a ControlLoop: its sampled plants are reused across designs
             law = linear_law(ctrl, plant_at.state_labels)
             source[:] = [law.source]

@@ -34,6 +34,7 @@ from .law import LinearLaw, state_gain
 
 __all__ = [
     "as_controller",
+    "controller_at",
     "static_gain",
     "python_law",
     "StateGain",
@@ -56,6 +57,17 @@ ACCEPTED = (
 def has_linear_law(controller) -> bool:
     """Whether a controller (or a gain schedule) has a linear law the analyses can use."""
     return callable(getattr(controller, "law", None)) or hasattr(controller, "at")
+
+
+def controller_at(controller, speed: float):
+    """The controller in force at ``speed`` [m/s]: a schedule (anything with ``at``) evaluated
+    there and what it returns checked by :func:`as_controller` at the schedule's rate."""
+    if not hasattr(controller, "at"):
+        return controller
+    inner = controller.at(speed)
+    if inner is controller or hasattr(inner, "at"):
+        raise InputError(f"controller.at({speed:g}) returned a schedule, not a controller")
+    return as_controller(inner, sample_rate=1.0 / controller.dt)
 
 
 def as_controller(
@@ -230,7 +242,12 @@ class PythonLaw:
 
     def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
         t = self._k * self.dt
-        out = self.fn(t, y, x) if self.needs_state else self.fn(t, y)
+        try:
+            out = self.fn(t, y, x) if self.needs_state else self.fn(t, y)
+        except Exception as exc:  # the user's code: reported as an input error, with its place
+            raise InputError(
+                f"{self.name}: raised {type(exc).__name__} at t = {t:g} s: {exc}"
+            ) from exc
         try:
             c = np.asarray(out, dtype=float).reshape(-1)
         except (TypeError, ValueError):

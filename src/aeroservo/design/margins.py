@@ -30,6 +30,7 @@ import numpy as np
 import scipy.optimize as so
 
 from ..errors import InputError
+from .interface import controller_at
 from .law import delayed
 from .margin_channel import (
     ChannelMargins,
@@ -250,9 +251,7 @@ def loop_margins(
     from .closed_loop import linear_controller
 
     speed = float(getattr(plant, "speed", np.nan))
-    ctrl = linear_controller(controller, "loop_margins", sample_rate)
-    if hasattr(ctrl, "at"):
-        ctrl = ctrl.at(speed)
+    ctrl = controller_at(linear_controller(controller, "loop_margins", sample_rate), speed)
     law = linear_law(ctrl, plant_states(plant))
     if not law.has_feedback:
         raise InputError("loop_margins: the controller has no feedback (open loop)")

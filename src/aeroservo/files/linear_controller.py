@@ -15,7 +15,7 @@ python-control (``K`` a ``StateSpace``)::
              inputs=K.input_labels, outputs=K.output_labels)
 
 A sample time of 0 is a continuous compensator (discretised at the loop's rate), MATLAB's -1
-(unspecified) a discrete one at the loop's rate.
+(unspecified) a discrete one at the loop's rate; a file without one is refused (no guess).
 """
 
 from __future__ import annotations
@@ -64,6 +64,7 @@ def _load(path: Path) -> dict:
             raise InputError(f"{path}: not a readable .npz file ({exc})") from None
     if suffix == ".mat":
         from scipy.io import loadmat
+        from scipy.io.matlab import MatReadError
 
         try:
             return loadmat(path, squeeze_me=False, chars_as_strings=True)
@@ -71,7 +72,7 @@ def _load(path: Path) -> dict:
             raise InputError(
                 f"{path}: a MATLAB v7.3 (HDF5) file; save it with save(..., '-v7')"
             ) from None
-        except (OSError, ValueError, TypeError) as exc:
+        except (OSError, ValueError, TypeError, MatReadError) as exc:
             raise InputError(f"{path}: not a readable .mat file ({exc})") from None
     raise InputError(f"{path}: expected a .npz or .mat file, not {suffix or 'no suffix'!r}")
 
@@ -98,12 +99,12 @@ def read_linear_controller(path: str | Path) -> dict:
     for key in ("A", "B", "C", "D"):
         if key not in data:
             raise InputError(f"{path}: variable {key} is missing (give A, B, C, D)")
-        try:
-            a = np.asarray(data[key], dtype=float)
-        except (TypeError, ValueError):
-            raise InputError(f"{path}: variable {key} is not a real matrix") from None
-        if a.ndim > 2 or not np.all(np.isfinite(a)):
-            raise InputError(f"{path}: variable {key}: expected a finite real matrix")
+        a = np.asarray(data[key])
+        if a.dtype.kind not in "iuf" or a.ndim > 2:
+            raise InputError(f"{path}: variable {key}: expected a real matrix, not {a.dtype}")
+        a = a.astype(float)
+        if not np.all(np.isfinite(a)):
+            raise InputError(f"{path}: variable {key}: has NaN or infinite entries")
         out[key] = np.atleast_2d(a) if a.size else a.reshape(0, 0)
     D = out["D"]
     m, p = D.shape
@@ -119,7 +120,17 @@ def read_linear_controller(path: str | Path) -> dict:
                 f"{shape}"
             )
     t = next((k for k in TIME_KEYS if k in data), None)
-    dt = 0.0 if t is None else float(np.asarray(data[t], dtype=float).ravel()[0])
+    if t is None:
+        raise InputError(
+            f"{path}: no sample time: save {TIME_KEYS[0]} (or {TIME_KEYS[1]}) [s], 0 for a "
+            "continuous compensator"
+        )
+    ts = np.asarray(data[t])
+    if ts.dtype.kind not in "iuf" or ts.size != 1:
+        raise InputError(
+            f"{path}: {t}: expected one sample time [s], not {ts.dtype} of size {ts.size}"
+        )
+    dt = float(ts.ravel()[0])
     if not np.isfinite(dt) or (dt < 0 and dt != -1):
         raise InputError(f"{path}: {t} = {dt:g}: expected a sample time >= 0 s (or -1)")
     out["dt"] = None if dt == -1 else dt

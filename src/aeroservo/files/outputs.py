@@ -70,9 +70,9 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
             if boundary is not None:
                 png = out / f"{sc.result}_boundary.png"
                 e = run.judgement.engaged
-                fig = boundary.plot(open_loop=run.flutter, engaged=(e.low, e.high))
-                if e.stable_to > e.high:
-                    fig.axes[0].axvline(e.stable_to, color="g", ls=":", lw=1)
+                fig = boundary.plot(
+                    open_loop=run.flutter, engaged=(e.low, e.high), stable_to=e.stable_to
+                )
                 fig.axes[0].set_title(
                     f"{sc.name}\nengaged {e.text()} (shaded), stability required to "
                     f"{e.stable_to:.4g} m/s (dotted)",

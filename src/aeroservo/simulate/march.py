@@ -15,7 +15,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from .._threads import blas_limited
-from ..design.interface import as_controller
+from ..design.interface import as_controller, controller_at
 from ..design.law import delayed
 from ..design.plant import Limits, SampledPlant
 from ..design.sampled_loop import linear_law, plant_states
@@ -95,8 +95,8 @@ def simulate(
     """
     check_continuous("plant", plant)
     controller = as_controller(controller, sample_rate=sample_rate)
-    if hasattr(controller, "at"):  # a gain schedule: the controller at the plant's speed
-        controller = controller.at(float(getattr(plant, "speed", np.nan)))
+    # a gain schedule: the controller at the plant's speed
+    controller = controller_at(controller, float(getattr(plant, "speed", np.nan)))
     law = None
     if callable(getattr(controller, "law", None)) and getattr(controller, "is_linear", True):
         law = linear_law(controller, plant_states(plant))

@@ -58,6 +58,22 @@ def _law_matrix(sp, law, s_idx):
     return M, (ix, i_s, irb, iq, iu, idd, iab, iad), (Cm, B, C, D)
 
 
+def _checked(c, m: int, controller) -> np.ndarray:
+    """A protocol controller's command as ``m`` floats, or an InputError naming it."""
+    try:
+        out = np.asarray(c, dtype=float)
+    except (TypeError, ValueError):
+        out = None
+    if out is None or out.shape not in ((m,), (m, 1), (1, m)):
+        from ..errors import InputError, show_value
+
+        raise InputError(
+            f"controller {type(controller).__name__}: command returned {show_value(c)}; "
+            f"expected {m} number(s), one per control"
+        )
+    return out.reshape(m)
+
+
 def march_loop(
     sp, controller, law, x0, d, noise, s_idx, rec_idx, mag, rate_dt, delay, n_steps, rec
 ):
@@ -148,7 +164,7 @@ def march_loop(
         else:
             for zk, zk1, ak, ck in zip(Z[:nb], head[1 : nb + 1], a[k0 : k0 + nb], cmd, strict=True):
                 ys = zk[irb] + ak
-                c = command(ys, zk[ix].copy())
+                c = _checked(command(ys, zk[ix].copy()), m, controller)
                 if delay:
                     c, pending = pending, np.asarray(c, dtype=float)
                 u = minimum(maximum(c, h - rate_dt), h + rate_dt)
