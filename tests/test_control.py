@@ -230,7 +230,9 @@ def test_saturated_lqr_loses_stability_where_mpc_keeps_it(case):
     lim = Limits(magnitude={HM: 300.0}, rate={HM: 1e5})
     rate = 250.0
     Kx = lqr(case.design(), CONTROLS, bryson=br, state_map=case.T, sample_rate=rate)
-    r_lqr = simulate(case.plant(), Kx, duration=3.0, x0=case.x0(0.031), limits=lim)
+    with pytest.warns(RuntimeWarning, match="run away while the actuator saturates"):
+        r_lqr = simulate(case.plant(), Kx, duration=3.0, x0=case.x0(0.031), limits=lim)
+    assert r_lqr.windup()  # issue 24: the diverging saturated loop is reported
     M = make_mpc(case, limits=lim, bryson=br, horizon=40, sample_rate=rate)
     r_mpc = simulate(
         case.plant(filtered=True), M, duration=3.0, x0=case.x0(0.031, True), limits=lim
