@@ -112,7 +112,6 @@ class LoopBlocks:
         Bw[ic] = Lm
         Co[:, ic] = law.C
         self.Az, self.Bw, self.Bv, self.Co, self.Dv, self.Cm = Az, Bw, Bv, Co, law.D, Cm
-        self.sizes = {"n_x": n, "n_h": n_h, "n_s": ns}
 
     def closed(self) -> np.ndarray:
         """Transition matrix of the closed loop."""

@@ -66,12 +66,13 @@ def _load(path: Path) -> dict:
         from scipy.io import loadmat
         from scipy.io.matlab import MatReadError
 
+        with open(path, "rb") as fh:  # the 128-byte text header names the format version
+            if fh.read(116).startswith(b"MATLAB 7.3"):
+                raise InputError(
+                    f"{path}: a MATLAB v7.3 (HDF5) file; save it with save(..., '-v7')"
+                )
         try:
             return loadmat(path, squeeze_me=False, chars_as_strings=True)
-        except NotImplementedError:
-            raise InputError(
-                f"{path}: a MATLAB v7.3 (HDF5) file; save it with save(..., '-v7')"
-            ) from None
         except (OSError, ValueError, TypeError, MatReadError) as exc:
             raise InputError(f"{path}: not a readable .mat file ({exc})") from None
     raise InputError(f"{path}: expected a .npz or .mat file, not {suffix or 'no suffix'!r}")

@@ -169,14 +169,17 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         speed = scenario.speed_factor * vf
     loop = scenario.loop(model)
     spec = scenario.controller
+    from ..design.interface import controller_at
+
     controller = loop.design_controller(spec, speed, scenario.sample_rate, vf)
+    at = controller_at(controller, speed)  # a schedule at the scenario's speed
     plant = loop.plant(speed)
     dist = scenario.disturbance
     x0 = loop.initial_state(dist.initial_tip) if dist.initial_tip else None
     noise = {k: np.sqrt(v) for k, v in scenario.sensor_noise.items()} or None
     result = simulate(
         plant,
-        controller.at(speed) if hasattr(controller, "at") else controller,
+        at,
         duration=scenario.duration,
         x0=x0,
         disturbance=dist.gust,
@@ -212,7 +215,6 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
                 "rms": float(np.sqrt(np.mean(y**2))),
                 "growth": signal_growth(y),
             }
-    at = controller.at(speed) if hasattr(controller, "at") else controller
     sat, rl = summary["saturated_fraction"], summary["rate_limited_fraction"]
     limited = {c: max(sat[c], rl[c]) for c in sat}
     summary.update(loop_verdict(plant, at, scenario.delay, summary["signals"], limited))
