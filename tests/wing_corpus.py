@@ -529,3 +529,322 @@ def corpus(seed: int = SEED) -> list[Case]:
     rng = np.random.default_rng(seed)
     with threadpool_limits(1):  # small dense eigenproblems: one BLAS thread is fastest
         return [_case(rng, klass, k) for klass, n in CLASSES.items() for k in range(n)]
+
+
+# --------------------------------------------------------------------------------------------
+# issue 26: wings with clusters of nearly repeated flap modes and very light wings
+#
+# A separate generator with its own seed: corpus() and CLASSES above are unchanged. Each case
+# has its own random stream (seed, class, k), so one case can be built without the others.
+
+CLUSTER_SEED = 20261226
+
+CLUSTER_CLASSES = {"flap_no_gj": 3, "light_low_mass_ratio": 3, "many_flap_nodes": 2}
+"""Number of cases per class of the cluster corpus (:func:`cluster_corpus`).
+
+* ``flap_no_gj``: a flap with ``GJ = 0`` held only by its distributed hinge spring (uncoupled
+  flap frequency 0.8-2 x the first torsion frequency), 30-40 elements: every flap node carries
+  a nearly independent flap rotation, so the spectrum has a cluster of nearly repeated flap
+  modes, one per flap node (12-13 of them within 1 % of each other in the seeded cases).
+* ``light_low_mass_ratio``: mass ratio ``m / (rho pi b^2)`` 2-5 at sea level, a flap with
+  some GJ over the outer half, mass-unbalanced, 40 elements; the lowest flutter onset has a
+  frequency above ``1.1 max(3 f_T1, 2 f_F1)`` (f_T1 the first torsion, f_F1 the first flap
+  frequency), i.e. above the band of modes that ``docs/stability.md`` (step 3) keeps by
+  default.
+* ``many_flap_nodes``: a flap over half the span or more with a soft hinge (0.3-0.9 x the first
+  torsion frequency) and a low flap GJ, 40 and 46 elements: many flap modes spread through
+  the flutter band.
+"""
+
+CLUSTER_SCAN_POINTS = 60
+"""Grid points of the coarse scan that chooses v_max (the models have 300-450 states)."""
+
+HIGH_FREQUENCY = 10.0
+"""Draws with an onset below v_max above HIGH_FREQUENCY x f_T1 are redrawn: such onsets (seen
+at thousands of Hz in light wings with a flap) are modes with damping ratios of about 1e-6
+that cross the axis with the exact Theodorsen function too; they are a property of the
+discretisation and not what these classes are about."""
+
+
+@dataclass(frozen=True)
+class Onset:
+    """An onset of the coarse scan: mid-interval speed [m/s] and frequency [Hz]."""
+
+    speed: float
+    frequency: float
+
+
+def scan_onsets(
+    model: aes.AeroelasticModel,
+    density: float,
+    v_top: float,
+    n: int = CLUSTER_SCAN_POINTS,
+    until: float = np.inf,
+) -> tuple[list[Onset], float | None]:
+    """Approximate flutter onsets with their frequencies and the first divergence on (0, v_top].
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    density : float
+        Air density [kg/m^3].
+    v_top : float
+        Upper end of the scan [m/s].
+    n : int
+        Grid points.
+    until : float
+        Stop the scan above ``until`` times the speed of the first onset.
+
+    Returns
+    -------
+    onsets : list of Onset
+        Where the number of unstable oscillatory eigenvalues goes up, with the frequency of each
+        unstable eigenvalue that has no unstable neighbour (within 2 % of its modulus) at the
+        previous speed; in increasing speed.
+    divergence : float or None
+        Mid-interval speed where the number of positive real eigenvalues first goes up.
+    """
+    speeds = np.linspace(v_top / n, v_top, n)
+    onsets: list[Onset] = []
+    divergence = None
+    prev_unstable, prev_real = np.empty(0, complex), 0
+    for i, v in enumerate(speeds):
+        if onsets and v > until * onsets[0].speed:
+            break
+        lam = sla.eigvals(model.state_matrix(v, density))
+        mag = np.abs(lam)
+        osc = lam[(lam.imag > 1e-6 * mag) & (mag > 1e-9)]
+        unstable = osc[osc.real > 0]
+        n_real = int(np.sum((np.abs(lam.imag) <= 1e-6 * mag) & (lam.real > 0)))
+        if i > 0:
+            mid = 0.5 * (speeds[i - 1] + v)
+            if unstable.size > prev_unstable.size:
+                for lam_u in unstable:
+                    if not np.any(np.abs(prev_unstable - lam_u) < 0.02 * abs(lam_u)):
+                        onsets.append(Onset(float(mid), float(lam_u.imag / (2 * np.pi))))
+            if n_real > prev_real and divergence is None:
+                divergence = float(mid)
+        prev_unstable, prev_real = unstable, n_real
+    return onsets, divergence
+
+
+def _first_torsion_hz(model: aes.AeroelasticModel) -> float:
+    """First in-vacuo frequency [Hz] labelled torsion (the second mode if none is)."""
+    modes = model.natural_modes(min(12, model.n_dofs))
+    torsion = [
+        f for f, lab in zip(modes.frequencies, modes.labels, strict=True) if "torsion" in lab
+    ]
+    return float(torsion[0] if torsion else modes.frequencies[min(1, modes.frequencies.size - 1)])
+
+
+def _first_flap_hz(model: aes.AeroelasticModel) -> float:
+    """First in-vacuo frequency [Hz] labelled flap (inf if none of the lowest 24 is)."""
+    modes = model.natural_modes(min(24, model.n_dofs))
+    flap = [f for f, lab in zip(modes.frequencies, modes.labels, strict=True) if "flap" in lab]
+    return float(flap[0]) if flap else float("inf")
+
+
+def _cluster_flap(
+    rng: np.random.Generator,
+    start: float,
+    end: float,
+    semichord: float,
+    wing_mass: float,
+    flap_hz: float,
+    gj_fraction: float | None,
+    balanced_share: float = 0.25,
+) -> aes.ControlSurface:
+    """A trailing-edge flap scaled with its wing.
+
+    Parameters
+    ----------
+    wing_mass : float
+        Mass per length of the wing section [kg/m]; the flap has 3-12 % of it.
+    flap_hz : float
+        Uncoupled flap frequency [Hz] of the hinge spring alone: ``k = I_beta (2 pi f)^2``.
+    gj_fraction : float or None
+        None: ``GJ = 0`` (the flap is held by its hinge spring only); else
+        ``GJ = gj_fraction k L^2`` with ``L`` the flap span (``gj_fraction pi^2`` is the
+        relative stiffening of the first spanwise flap shape).
+    balanced_share : float
+        Probability of a mass-balanced flap (S_beta = 0); otherwise its CG is 30-60 % of the
+        flap chord aft of the hinge.
+    """
+    hinge = _u(rng, 0.45, 0.65)
+    chord = semichord * (1.0 - hinge)
+    mass = wing_mass * _u(rng, 0.03, 0.12)
+    d = 0.0 if rng.uniform() < balanced_share else _u(rng, 0.3, 0.6) * chord
+    inertia = mass * (_u(rng, 0.06, 0.2) * chord**2 + d * d)
+    k = inertia * (2 * np.pi * flap_hz) ** 2
+    gj = 0.0 if gj_fraction is None else gj_fraction * k * (end - start) ** 2
+    return aes.ControlSurface(
+        name="flap",
+        start=start,
+        end=end,
+        hinge=hinge,
+        static_moment=mass * d,
+        inertia=inertia,
+        GJ=gj,
+        hinge_stiffness=k,
+    )
+
+
+def _torsion_hz_of(span: float, segments: list[aes.Segment]) -> float:
+    """First torsion frequency [Hz] of the clean wing (10 elements)."""
+    clean = aes.AeroelasticModel(aes.Wing(span, segments, name="clean"), n_elements=10)
+    return _first_torsion_hz(clean)
+
+
+def _draw_flap_no_gj(rng: np.random.Generator, k: int) -> Draw:
+    """Goland-like (k even) or two or three segments of independently drawn Goland-like
+    sections (k odd), a GJ = 0 flap inboard, mid or outboard."""
+    span = GOLAND_SPAN * _u(rng, 0.9, 1.4)
+    if k % 2 == 0:
+        sections = [_goland_section(rng)]
+        edges = [0.0, span]
+    else:
+        n_seg = 2 + (k // 2) % 2
+        sections = [_goland_section(rng, spread=0.3) for _ in range(n_seg)]
+        cuts = np.sort(rng.uniform(0.2, 0.8, n_seg - 1))
+        edges = list(np.r_[0.0, cuts, 1.0] * span)
+    segs = [
+        _segment(edges[i], edges[i + 1], s, name=f"segment{i + 1}") for i, s in enumerate(sections)
+    ]
+    f_t = _torsion_hz_of(span, segs)
+    x0, x1 = _span_interval(rng, _WHERE[k % 3], span)
+    at = int(np.searchsorted(edges, 0.5 * (x0 + x1))) - 1  # the segment under the flap middle
+    s = sections[at]
+    cs = _cluster_flap(rng, x0, x1, s["semichord"], s["mass"], f_t * _u(rng, 0.8, 2.0), None)
+    wing = aes.Wing(span, segs, [cs], name=f"flap GJ = 0 ({len(segs)} segments)")
+    return Draw(wing, _goland_density(rng), int(rng.integers(30, 41)))
+
+
+def _draw_light(rng: np.random.Generator, k: int) -> Draw:
+    """Mass ratio 2-5 at sea level; stiffnesses near those of issue 26's light wing."""
+    span = 7.3512 * _u(rng, 0.9, 1.1)
+    b = 0.76621 * _u(rng, 0.85, 1.15)
+    mu = _u(rng, 2.0, 5.0)
+    mass = mu * 1.225 * np.pi * b * b
+    x_alpha = _u(rng, 0.0, 0.08)
+    r2 = 0.99369 / (7.5640 * 0.76621**2) * _u(rng, 0.8, 1.2)  # issue 26's light wing: 0.22
+    s = {
+        "semichord": b,
+        "a": _u(rng, -0.5, -0.4),
+        "mass": mass,
+        "x_alpha": x_alpha,
+        "inertia": _inertia(mass, b, x_alpha, r2),
+        "EI": 2.8575e6 * _u(rng, 0.8, 1.2),
+        "GJ": 6.4048e5 * _u(rng, 0.8, 1.2),
+    }
+    segs = [_segment(0.0, span, s, "light")]
+    f_t = _torsion_hz_of(span, segs)
+    x0 = span * _u(rng, 0.45, 0.55)
+    flap_hz = f_t * _u(rng, 1.5, 2.0)
+    cs = _cluster_flap(rng, x0, span, b, mass, flap_hz, _u(rng, 0.005, 0.02), balanced_share=0.0)
+    wing = aes.Wing(span, segs, [cs], name=f"light wing (mass ratio {mu:.2f})")
+    return Draw(wing, 1.225, 40)
+
+
+def _draw_many_flap_nodes(rng: np.random.Generator, k: int) -> Draw:
+    """Goland-like wing, a flap over 50-90 % of the span with a soft hinge (0.3-0.9 x the first
+    torsion frequency) and a low flap GJ."""
+    s = _goland_section(rng)
+    span = GOLAND_SPAN
+    length = _u(rng, 0.5, 0.9) * span
+    x1 = span if rng.uniform() < 0.5 else _u(rng, 0.9, 0.95) * span
+    x0 = max(x1 - length, 0.05 * span)
+    f_t = _torsion_hz_of(span, [_segment(0.0, span, s, "goland")])
+    flap_hz = f_t * _u(rng, 0.3, 0.9)
+    cs = _cluster_flap(rng, x0, x1, s["semichord"], s["mass"], flap_hz, _u(rng, 0.005, 0.05))
+    wing = aes.Wing(span, [_segment(0.0, span, s, "goland")], [cs], name="long flap")
+    return Draw(wing, _goland_density(rng), 40 + 6 * k)
+
+
+CLUSTER_DRAWS: dict[str, Callable[[np.random.Generator, int], Draw]] = {
+    "flap_no_gj": _draw_flap_no_gj,
+    "light_low_mass_ratio": _draw_light,
+    "many_flap_nodes": _draw_many_flap_nodes,
+}
+
+LIGHT_BAND_FACTOR = 1.1
+"""A light case's lowest onset is above this multiple of ``max(3 f_T1, 2 f_F1)`` (issue 26's
+light wing: 105.4 Hz, 1.13 x 93.3 Hz)."""
+
+CLUSTER_V_LIMIT = 900.0
+"""Largest v_max [m/s] of a cluster case (the engine accepts speeds up to 1000 m/s)."""
+
+CLUSTER_MAX_DRAWS = 60
+"""Draws per cluster case before the generator gives up (a generator bug)."""
+
+
+def _cluster_target(
+    klass: str, model: aes.AeroelasticModel, onsets: list[Onset], f_t: float
+) -> Onset | None:
+    """The onset the class is about (v_max is 1.3-2x its speed), or None to redraw."""
+    if not onsets:
+        return None
+    first = onsets[0]
+    if klass == "light_low_mass_ratio":  # every onset of the first scan interval above the band
+        band = max(3.0 * f_t, 2.0 * _first_flap_hz(model))
+        lowest = min(o.frequency for o in onsets if o.speed == first.speed)
+        return first if lowest > LIGHT_BAND_FACTOR * band else None
+    return first
+
+
+def cluster_case(name: str, seed: int = CLUSTER_SEED) -> Case:
+    """One case of the cluster corpus by name (e.g. ``"flap_no_gj_02"``), built on its own.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`cluster_case_names`.
+    seed : int
+        Seed of the cluster corpus.
+    """
+    klass, k = name.rsplit("_", 1)
+    k = int(k) - 1
+    if klass not in CLUSTER_CLASSES or not 0 <= k < CLUSTER_CLASSES[klass]:
+        raise KeyError(name)
+    rng = np.random.default_rng([seed, list(CLUSTER_CLASSES).index(klass), k])
+    with threadpool_limits(1):
+        for _ in range(CLUSTER_MAX_DRAWS):
+            try:
+                draw = CLUSTER_DRAWS[klass](rng, k)
+            except aes.InputError:
+                continue
+            model = aes.AeroelasticModel(draw.wing, n_elements=draw.n_elements)
+            if not _no_sliver(model):
+                continue
+            f_t = _first_torsion_hz(model)
+            onsets, _ = scan_onsets(model, draw.density, _v_top(model), until=2.0)
+            target = _cluster_target(klass, model, onsets, f_t)
+            if target is None:
+                continue
+            v_max = float(np.round(target.speed * _u(rng, 1.3, 2.0), 3))
+            if v_max > CLUSTER_V_LIMIT:
+                continue
+            if any(o.speed < v_max and o.frequency > HIGH_FREQUENCY * f_t for o in onsets):
+                continue
+            return Case(name, klass, model, float(draw.density), v_max)
+    raise RuntimeError(f"wing_corpus: no valid {klass} case in {CLUSTER_MAX_DRAWS} draws")
+
+
+def cluster_case_names() -> list[str]:
+    """Names of the cluster corpus cases, known without building them."""
+    return [case_name(klass, k) for klass, n in CLUSTER_CLASSES.items() for k in range(n)]
+
+
+def cluster_corpus(seed: int = CLUSTER_SEED) -> list[Case]:
+    """The issue-26 corpus of :data:`CLUSTER_CLASSES` (deterministic for a seed).
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the cluster corpus; each case draws from ``default_rng([seed, class, k])``.
+
+    Returns
+    -------
+    list of Case
+        Class by class in the order of :data:`CLUSTER_CLASSES`.
+    """
+    return [cluster_case(name, seed) for name in cluster_case_names()]

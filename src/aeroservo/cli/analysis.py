@@ -196,13 +196,16 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
                 model, s.atmosphere, compressibility=s.compressibility, solver=pk_flutter, **kw
             )
         else:
-            pk = pk_flutter(model, s.density, **kw)
+            pk = pk_flutter(model, s.density, boundary=result, **kw)
         out["pk_exact_theodorsen"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
             "flutter_eas": pk.flutter_eas,
             "flutter_mach": pk.flutter_mach,
             "divergence_speed": pk.divergence_speed,
+            "n_modes_followed": pk.info.get("n_modes"),
+            "restarted_at_onsets": pk.info.get("restarted_at_onsets", []),
+            "warnings": list(pk.warnings),
         }
     title = f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
     writers = []
@@ -231,7 +234,7 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         from ..atomic import atomic_write_set
 
         atomic_write_set(writers)  # all the files, or none
-    for w in dict.fromkeys(result.warnings):  # each once
+    for w in dict.fromkeys(result.warnings + (pk.warnings if pk is not None else [])):
         print(f"aeroservo: warning: {w}", file=sys.stderr)
     if args.json:
         print(json.dumps(out, indent=2))

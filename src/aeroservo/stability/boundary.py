@@ -26,18 +26,17 @@ V-g plots show ``g = -2 zeta`` (positive: unstable).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import RANGES, InputError, check_int, check_number
+from ..errors import RANGES, InputError, check_int, check_number, check_quantity
 from ..system.first_order import FirstOrderSystem
 from .branches import Branches, is_complex, sweep_branches
-from .certificate import DENSE_LIMIT, Certificate, certify, truncated_modes
+from .certificate import DENSE_LIMIT, Certificate, certify, checked_basis
 from .crossings import VerificationError, Verifier, branch_crossings, sign_changes
 from .divergence import divergence_speeds
-from .modal import MIN_MODES, ModalBasis, ModalSystem, modal_basis, modal_system
+from .modal import MIN_MODES, ModalBasis, ModalSystem, modal_basis, modal_info, modal_system
 from .result import Crossing, FlutterResult
 from .tracking import EigenTracker
 
@@ -69,7 +68,7 @@ def _as_system(
 
 def default_v_max(semichord: float, omega_2: float, v_div: np.ndarray) -> float:
     """Default upper speed [m/s]: 1.2 x the first divergence speed, at most 8 b omega_2, or
-    4 b omega_2 without divergence.
+    4 b omega_2 without divergence; never above the documented speed range (1000 m/s).
 
     Parameters
     ----------
@@ -81,9 +80,8 @@ def default_v_max(semichord: float, omega_2: float, v_div: np.ndarray) -> float:
         Static divergence speeds [m/s], increasing.
     """
     ref = semichord * omega_2
-    if v_div.size:
-        return float(min(1.2 * v_div[0], 8.0 * ref))
-    return float(4.0 * ref)
+    v = min(1.2 * v_div[0], 8.0 * ref) if v_div.size else 4.0 * ref
+    return float(min(v, RANGES["flight_speed"].hi))
 
 
 @blas_limited
@@ -147,9 +145,11 @@ def flutter_boundary(
     omega_2 = float(np.abs(lam_full0[min(1, lam_full0.size - 1)]))
     if v_max is None:
         v_max = default_v_max(system.semichord, omega_2, v_div)
-    v_max = check_number("v_max", v_max, unit="m/s", lo=RANGES["flight_speed"].lo)
+    v_max = check_quantity("v_max", v_max, "flight_speed")
     tracker = EigenTracker(system)
-    basis = _checked_basis(src, n_min, rho, v_max, mach) if src is not None else None
+    enlarged: list[dict] = []
+    band_hz = modal_basis(src, n_min).cutoff if src is not None else None
+    basis = checked_basis(src, n_min, rho, v_max, mach, enlarged) if src is not None else None
     crossings: list[Crossing] | None = None
     for attempt in range(MAX_ENLARGE + 1):
         modal = _modal(src, system, basis, n_modes)
@@ -175,14 +175,26 @@ def flutter_boundary(
             f"({basis.n_modes} modes, band up to {basis.cutoff:.4g} Hz) lacked or misplaced; "
             f"swept again with the band up to {cutoff:.4g} Hz"
         )
-        basis = _checked_basis(src, n_min, rho, v_max, mach, cutoff)
+        n_before = basis.n_modes
+        band_hz = cutoff
+        basis = checked_basis(src, n_min, rho, v_max, mach, enlarged, cutoff)
+        enlarged.append(
+            {
+                "by": why,
+                "modes": [n_before, basis.n_modes],
+                "reason": f"lightly damped mode near {lost:.4g} Hz missing or misplaced",
+            }
+        )
     if not cert.ok:
+        top = min(top, min(v for v, _lam in cert.missing))
         warnings.append(
-            "the certificate still finds full-model eigenvalues the modal model lacks: "
+            f"search complete only up to {top:.6g} m/s: the certificate still finds full-model "
+            "eigenvalues the modal model lacks or misplaces: "
             + ", ".join(
                 f"{abs(lam.imag) / (2 * np.pi):.4g} Hz at {v:.4g} m/s"
                 for v, lam in cert.missing[:3]
             )
+            + "; try more modes (n_modes, --modes) and report the wing if it persists"
         )
     if br.stopped:
         warnings.append(f"search stopped at {top:.6g} m/s: {br.stopped}; results below it stand")
@@ -208,7 +220,9 @@ def flutter_boundary(
         "n_speeds": int(br.n_speeds),
         "ambiguous_steps": int(br.n_ambiguous),
         "divergence_speeds": [float(v) for v in v_div if v <= top],
-        "modal_model": _modal_info(modal),
+        "modal_model": modal_info(modal)
+        | ({"band_hz": band_hz} if band_hz is not None else {})
+        | ({"enlarged": enlarged} if enlarged else {}),
         "certificate": cert.to_dict(),
     }
     return FlutterResult(
@@ -228,25 +242,6 @@ def flutter_boundary(
         compressibility="prandtl-glauert" if mach > 0 else None,
         damping=_damping_text(src),
     )
-
-
-def _checked_basis(
-    src, n_min: int, rho: float, v_max: float, mach: float, cutoff=None
-) -> ModalBasis:
-    """The rule's modes, plus every mode the truncation check cannot leave out."""
-    basis = modal_basis(src, n_min, cutoff)
-    notes = []
-    for _ in range(8):
-        n_band = int(np.sum(basis.frequencies <= basis.cutoff * (1 + 1e-9)))
-        bad = truncated_modes(src, n_band, rho, v_max, mach)
-        if not bad:
-            break
-        f_bad, why = max(bad)
-        notes.append(f"{f_bad:.4g} Hz ({why})")
-        basis = modal_basis(src, n_min, max(basis.cutoff, 1.01 * f_bad))
-    if notes:
-        basis = replace(basis, rule=basis.rule + "; kept as well: " + ", ".join(notes))
-    return basis
 
 
 def _modal(src, system: FirstOrderSystem, basis: ModalBasis | None, n_modes) -> ModalSystem:
@@ -284,12 +279,19 @@ def _sweep(tracker: EigenTracker, src, modal: ModalSystem, v_max: float, progres
         def reference(v: float) -> np.ndarray:
             return np.linalg.eigvals(big.state_matrix(v)).astype(complex, copy=False)
 
+        unconfirmed = []
         for k in idx:
             for j in np.flatnonzero(
                 is_complex(br.eigenvalues[k]) & (np.abs(br.eigenvalues[k]) <= band_top)
             ):
-                ver.at(k, int(j))
+                try:
+                    ver.at(k, int(j))
+                except VerificationError as exc:  # a missing mode: enlarge, or stop there
+                    unconfirmed.append((exc.speed, exc.eigenvalue))
     cert = certify(reference, br, ver.exact, ver.values, idx, band_top, method)
+    if full.n_states > DENSE_LIMIT and unconfirmed:
+        cert.ok = False
+        cert.missing = sorted(unconfirmed[:1] + cert.missing, key=lambda m: m[0])
     return br, ver, cert
 
 
@@ -378,20 +380,3 @@ def modal_n_q(src) -> int:
 def _damping_text(src) -> str:
     damping = getattr(src, "damping", None)
     return damping.describe() if damping is not None else "none"
-
-
-def _modal_info(modal: ModalSystem) -> dict:
-    b = modal.basis
-    if b is None:
-        return {
-            "n_modes": modal.system.n_q,
-            "rule": "full model",
-            "n_states": modal.system.n_states,
-        }
-    return {
-        "n_modes": b.n_modes,
-        "cutoff_hz": b.cutoff,
-        "rule": b.rule,
-        "n_states": modal.system.n_states,
-        "lag_states": "projected" if modal.lag_basis is not None else "complete",
-    }

@@ -24,8 +24,9 @@ import numpy as np
 
 from ..system.first_order import FirstOrderSystem
 from .assignment import min_cost_assignment
+from .tracking import subspace_share
 
-__all__ = ["Branches", "sweep_branches", "is_complex"]
+__all__ = ["Branches", "sweep_branches", "is_complex", "cluster", "cluster_groups", "CLUSTER"]
 
 COMPLEX = 1e-7
 """A branch is complex (oscillatory) where ``Im(lambda) > COMPLEX |lambda|``."""
@@ -34,6 +35,45 @@ COMPLEX = 1e-7
 FAR_ZETA = 0.25
 """Branches whose ``|damping ratio|`` exceeds this at both ends of a step count half their change
 in the step control (:func:`sweep_branches`)."""
+
+
+CLUSTER = 1e-2
+"""Oscillatory branches whose eigenvalues lie within this fraction of their modulus of each
+other (transitively) form a cluster of nearly repeated eigenvalues (e.g. the flap modes of a
+control surface without torsional stiffness: one per mesh node). The modal error (up to about
+1e-2 of the modulus on fine meshes) then exceeds their separation, so each modal eigenvector is
+an arbitrary mixture of the cluster's full-model eigenvectors: a cluster is matched, verified
+and followed as one invariant subspace, not member by member."""
+
+
+def cluster_groups(rows: Sequence[np.ndarray]) -> list[list[int]]:
+    """Clusters (of two or more branches) of the branch eigenvalues in any of the rows: two
+    oscillatory branches within :data:`CLUSTER` of each other in one row are in one cluster."""
+    m = rows[0].size
+    near = np.zeros((m, m), dtype=bool)
+    for lam in rows:
+        osc = is_complex(lam)
+        close = np.abs(lam[:, None] - lam[None, :]) <= CLUSTER * np.abs(lam)[:, None]
+        near |= close & osc[:, None] & osc[None, :]
+    np.fill_diagonal(near, False)
+    groups, seen = [], np.zeros(m, dtype=bool)
+    for j in np.flatnonzero(near.any(axis=1)).tolist():
+        if seen[j]:
+            continue
+        group, todo = {j}, [j]
+        while todo:
+            for n in np.flatnonzero(near[todo.pop()]).tolist():
+                if n not in group:
+                    group.add(n)
+                    todo.append(n)
+        seen[list(group)] = True
+        groups.append(sorted(group))
+    return groups
+
+
+def cluster(rows: Sequence[np.ndarray], j: int) -> list[int]:
+    """Branch j's cluster in the rows (:func:`cluster_groups`), or ``[j]``."""
+    return next((g for g in cluster_groups(rows) if j in g), [j])
 
 
 def is_complex(lam: np.ndarray) -> np.ndarray:
@@ -187,9 +227,16 @@ def sweep_branches(
             d1 = cost[rows, cols]
             c2 = cost.copy()
             c2[rows, cols] = np.inf
+            corr = np.abs(np.einsum("ij,ij->j", vecs[-1].conj(), new_x)) ** 2  # unit vectors
+            # a cluster is matched as a whole: which member is which inside it is arbitrary
+            # (only the candidates outside it make a match ambiguous), and its eigenvectors
+            # must span the subspace the previous ones spanned
+            for g in cluster_groups([prev, new_l]):
+                rg = np.flatnonzero(np.isin(rows, g))
+                c2[np.ix_(rows[rg], cols[rg])] = np.inf
+                corr[g] = subspace_share(vecs[-1][:, g], new_x[:, g])
             d2 = c2.min(axis=1) if c2.shape[1] > 1 else np.full(rows.size, np.inf)
             clear = d1 <= 0.5 * d2 + 1e-12
-            corr = np.abs(np.einsum("ij,ij->j", vecs[-1].conj(), new_x)) ** 2  # unit vectors
             ok = bool(clear[osc[rows]].all()) and bool((corr[osc] >= mac_min).all())
         if not ok and (h > h_ambiguous or (not slow and h > h_min)):
             h = 0.5 * min(h, V1 - V)

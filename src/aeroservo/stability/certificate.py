@@ -24,15 +24,24 @@ A mode that fails either check joins the modal model and the sweep is redone
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..system.first_order import compressibility_factors
 from .assignment import min_cost_assignment
 from .branches import Branches, is_complex
+from .modal import ModalBasis, modal_basis
 
-__all__ = ["Certificate", "certify", "truncated_modes", "DENSE_LIMIT", "CERT_ZETA", "MATCH"]
+__all__ = [
+    "Certificate",
+    "certify",
+    "checked_basis",
+    "truncated_modes",
+    "DENSE_LIMIT",
+    "CERT_ZETA",
+    "MATCH",
+]
 
 DENSE_LIMIT = 250
 """Full models up to this many states are certified with dense ``eig``."""
@@ -233,3 +242,32 @@ def _modal_aero(model, n_kept: int) -> tuple:
         groups = [(g.b, diag(g.Pq), diag(g.Pd)) for g in am.circ_groups]
         cache[key] = (diag(am.Mnc), diag(am.Knc), diag(am.Cnc), groups)
     return cache[key]
+
+
+def checked_basis(
+    src, n_min: int, rho: float, v_max: float, mach: float, enlarged: list, cutoff=None
+) -> ModalBasis:
+    """The rule's modes, plus every mode the truncation check cannot leave out (an enlargement
+    is appended to ``enlarged``)."""
+    basis = modal_basis(src, n_min, cutoff)
+    n_before = basis.n_modes
+    notes = []
+    for _ in range(8):
+        n_band = int(np.sum(basis.frequencies <= basis.cutoff * (1 + 1e-9)))
+        bad = truncated_modes(src, n_band, rho, v_max, mach)
+        if not bad:
+            break
+        f_bad, why = max(bad)
+        notes.append(f"{f_bad:.4g} Hz ({why})")
+        basis = modal_basis(src, n_min, max(basis.cutoff, 1.01 * f_bad))
+    if notes:
+        basis = replace(basis, rule=basis.rule + "; kept as well: " + ", ".join(notes))
+        enlarged.append(
+            {
+                "by": "truncation check",
+                "modes": [n_before, basis.n_modes],
+                "reason": "modes left out must keep their frequency and aerodynamic damping: "
+                + ", ".join(notes),
+            }
+        )
+    return basis

@@ -17,11 +17,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .branches import Branches, is_complex
+from .branches import Branches, cluster, is_complex
 from .brent import brentq
 from .modal import ModalSystem
 from .result import Crossing
-from .tracking import EigenTracker, mac
+from .tracking import EigenTracker, mac, subspace_share
 
 __all__ = ["HUMP_ZETA", "SIGN_ZETA", "Verifier", "sign_changes", "branch_crossings"]
 
@@ -35,6 +35,11 @@ SIGN_ZETA = 2e-3
 """Branch eigenvalues with |damping ratio| below this, or below 10 x the branch's measured
 modal error (:func:`branch_crossings`), are recomputed on the full model before the sign of
 their real part is trusted; so are the grid points around every near-axis extremum."""
+
+
+CLUSTER_SHARE = 0.5
+"""Least fraction of each full-model eigenvector of a cluster that must lie in the span of the
+cluster's modal eigenvectors (the subspace form of the MAC test of a single branch)."""
 
 
 class VerificationError(RuntimeError):
@@ -80,8 +85,13 @@ class Verifier:
         return np.isfinite(self.values)
 
     def at(self, k: int, j: int) -> complex:
-        """Full-model eigenvalue of branch j at grid point k."""
+        """Full-model eigenvalue of branch j at grid point k (a branch in a cluster of nearly
+        repeated eigenvalues is verified with its whole cluster, :func:`cluster`)."""
         if not np.isfinite(self.values[k, j]):
+            group = cluster([self.br.eigenvalues[k]], j)
+            if len(group) > 1:
+                self._at_cluster(k, group)
+                return complex(self.values[k, j])
             lam_r = complex(self.br.eigenvalues[k, j])
             x0 = self.modal.lift(self.br.vectors[k, :, j])
             lam, x, conv = self.tracker.correct(float(self.br.speeds[k]), lam_r, x0)
@@ -97,6 +107,27 @@ class Verifier:
             self.values[k, j] = lam
             self._vec[(k, j)] = x
         return complex(self.values[k, j])
+
+    def _at_cluster(self, k: int, group: list[int]) -> None:
+        """Verify a cluster of branches at grid point k as one invariant subspace: every full
+        eigenvector found must lie mostly (:data:`CLUSTER_SHARE`) in the span of the cluster's
+        modal eigenvectors."""
+        v = float(self.br.speeds[k])
+        lam_r = self.br.eigenvalues[k, group]
+        X0 = self.modal.lift(self.br.vectors[k][:, group])
+        lam, X, conv = self.tracker.correct_cluster(v, lam_r, X0)
+        n_q = self.tracker.n_q
+        if not conv or subspace_share(X0[:n_q], X[:n_q]).min() < CLUSTER_SHARE:
+            raise VerificationError(
+                f"the full model has no eigenvalues matching the cluster of modal branches "
+                f"{', '.join(str(i + 1) for i in group)} at {v:.6g} m/s (modal "
+                f"{complex(lam_r[0]):.6g} ...)",
+                v,
+                complex(lam_r[0]),
+            )
+        for i, g in enumerate(group):
+            self.values[k, g] = lam[i]
+            self._vec[(k, g)] = X[:, i]
 
     def vector(self, k: int, j: int) -> np.ndarray:
         """Full-model eigenvector of branch j at grid point k."""
@@ -115,13 +146,28 @@ class Verifier:
 
     def _follow(self, j: int, k: int, v: float) -> complex:
         V = self.br.speeds
-        lam_k = self.at(k, j)
-        if k + 1 < V.size and np.isfinite(self.values[k + 1, j]):
+        rows = [self.br.eigenvalues[kk] for kk in (k, k + 1) if kk < V.size]
+        group = cluster(rows, j)
+        lam_k = np.array([self.at(k, i) for i in group])
+        guess = lam_k
+        if k + 1 < V.size and np.isfinite(self.values[k + 1, group]).all():
             t = (v - V[k]) / (V[k + 1] - V[k])
-            guess = lam_k + t * (self.values[k + 1, j] - lam_k)
-        else:
-            guess = lam_k
-        return self.tracker.follow(v, guess, self.vector(k, j), float(V[k]))[0]
+            guess = lam_k + t * (self.values[k + 1, group] - lam_k)
+        if len(group) == 1:
+            return self.tracker.follow(v, complex(guess[0]), self.vector(k, j), float(V[k]))[0]
+        X0 = np.column_stack([self.vector(k, i) for i in group])
+        lam, X, conv = self.tracker.correct_cluster(v, guess, X0)
+        n_q = self.tracker.n_q
+        if not conv or subspace_share(X0[:n_q], X[:n_q]).min() < CLUSTER_SHARE:
+            raise VerificationError(
+                f"the cluster of branches {', '.join(str(i + 1) for i in group)} could not be "
+                f"followed on the full model to {v:.6g} m/s",
+                float(v),
+                complex(guess[group.index(j)]),
+            )
+        for i, g in enumerate(group):
+            self._followed.setdefault((g, k, float(v)), complex(lam[i]))
+        return complex(lam[group.index(j)])
 
     def best(self, j: int | None = None) -> np.ndarray:
         """Branch j (default: every branch, as columns) on the grid: full-model values where

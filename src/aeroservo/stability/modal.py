@@ -32,7 +32,15 @@ from ..aero.indicial import wagner_set
 from ..system.first_order import FirstOrderSystem, first_order
 from ..system.matrices import AeroMatrices
 
-__all__ = ["MIN_MODES", "ModalBasis", "ModalSystem", "mode_rule", "modal_basis", "modal_system"]
+__all__ = [
+    "MIN_MODES",
+    "ModalBasis",
+    "ModalSystem",
+    "mode_rule",
+    "modal_basis",
+    "modal_info",
+    "modal_system",
+]
 
 MIN_MODES = 6
 """The modal model never has fewer modes than this (or all of them, if the model has fewer)."""
@@ -143,7 +151,7 @@ def modal_basis(model, n_min: int = MIN_MODES, cutoff: float | None = None) -> M
     if cutoff is not None and cutoff > cut:
         n = max(n, int(np.sum(freqs <= BUFFER * cutoff * (1 + 1e-9))))
         cut = cutoff
-        why = f"band up to {cutoff:.4g} Hz (enlarged by the certificate)"
+        why = f"band up to {cutoff:.4g} Hz (enlarged)"
         why += f"; modes up to {BUFFER:g} x that"
     n = min(n, freqs.size)
     return ModalBasis(phi[:, :n], freqs[:n], labels[:n], cut, why)
@@ -260,3 +268,20 @@ def modal_system(model, density: float, basis: ModalBasis | None, mach: float = 
     if skey not in cache:
         cache[skey] = first_order(am, wagner, density, model.semichord, mach=mach)
     return ModalSystem(cache[skey], basis, Q, wagner.n_terms)
+
+
+def modal_info(modal: ModalSystem) -> dict:
+    b = modal.basis
+    if b is None:
+        return {
+            "n_modes": modal.system.n_q,
+            "rule": "full model",
+            "n_states": modal.system.n_states,
+        }
+    return {
+        "n_modes": b.n_modes,
+        "cutoff_hz": b.cutoff,
+        "rule": b.rule,
+        "n_states": modal.system.n_states,
+        "lag_states": "projected" if modal.lag_basis is not None else "complete",
+    }

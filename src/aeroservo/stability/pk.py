@@ -23,13 +23,14 @@ import scipy.linalg as sla
 
 from .._threads import blas_limited
 from ..aero.theodorsen import theodorsen_function
-from ..errors import check_int, check_number
+from ..errors import check_int, check_number, check_quantity
 from ..system.first_order import check_mach, compressibility_factors
 from ..system.matrices import AeroMatrices
 from .boundary import default_v_max
 from .brent import brentq
 from .divergence import static_speeds
 from .modal import modal_basis
+from .pk_branches import restart, track
 from .result import Crossing, FlutterResult
 from .tracking import mac
 
@@ -126,6 +127,23 @@ class _PK:
         raise PKConvergenceError(f"p-k iteration did not converge at V = {V:.6g} m/s")
 
 
+ONSET_BAND = 1.5
+"""The p-k follows every mode up to at least this multiple of the highest onset frequency of
+the time-domain search (times the mode rule's buffer)."""
+
+
+def _followed_modes(model, boundary: FlutterResult) -> int:
+    """How many modes the p-k follows: the time-domain search's certified band (the modes
+    its truncation check added above the band are in the p-k's matrices anyway), widened to
+    :data:`ONSET_BAND` x its highest onset frequency."""
+    modal = boundary.info.get("modal_model", {})
+    if "band_hz" not in modal:
+        return int(modal.get("n_modes", model.matrices.n_q))
+    onsets = [c.frequency for c in boundary.crossings if c.kind == "onset"]
+    band = max([modal["band_hz"]] + [ONSET_BAND * f for f in onsets])
+    return modal_basis(model, cutoff=band).n_modes
+
+
 class PKConvergenceError(RuntimeError):
     """The p-k iteration found no consistent frequency for a branch."""
 
@@ -172,6 +190,7 @@ def pk_flutter(
     n_speeds: int = 41,
     rtol: float = 1e-7,
     mach: float = 0.0,
+    boundary: FlutterResult | None = None,
 ) -> FlutterResult:
     """Flutter boundary by the p-k method with the exact Theodorsen function.
 
@@ -185,8 +204,10 @@ def pk_flutter(
         Upper speed [m/s]; default as :func:`aeroservo.stability.boundary.default_v_max`
         (1.2 x the exact static divergence speed, at most 8 b omega_2, else 4 b omega_2).
     n_modes : int, optional
-        Lowest modes followed (default: the modes of the same physical rule as the time-domain
-        search, :func:`aeroservo.stability.modal.mode_rule`).
+        Lowest modes followed (the p-k's matrices always hold every mode). Default: every mode
+        of the band the time-domain search certified (its mode rule and every enlargement of
+        its certificate), up to 1.5 x its highest onset frequency at least
+        (:data:`ONSET_BAND`).
     n_speeds : int
         Uniform grid points from 0 to ``v_max`` (crossings are then found by root finding).
     rtol : float
@@ -194,6 +215,12 @@ def pk_flutter(
     mach : float
         Mach number of the Prandtl-Glauert correction, ``C(k) -> C(k / beta^2) / beta``
         (0: incompressible).
+    boundary : FlutterResult, optional
+        The time-domain search of the same model, density and Mach number
+        (:func:`aeroservo.flutter_boundary`). Without ``n_modes`` it is computed if not given:
+        the p-k follows the modes of its modal model and is restarted at each of its onsets
+        (the p-k crossing next to it is added if the branch tracking missed it, with a
+        warning), so that no p-k root below the reported flutter speed crosses unseen.
 
     Returns
     -------
@@ -203,7 +230,11 @@ def pk_flutter(
     rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
     am: AeroMatrices = model.matrices
     if n_modes is None:
-        n_modes = modal_basis(model).n_modes
+        if boundary is None:
+            from .boundary import flutter_boundary
+
+            boundary = flutter_boundary(model, rho, v_max=v_max, mach=mach)
+        n_modes = _followed_modes(model, boundary)
     n_modes = check_int("n_modes", n_modes, lo=1, hi=am.n_q)
     n_speeds = check_int("n_speeds", n_speeds, lo=3)
     mach = check_mach(mach)
@@ -215,26 +246,9 @@ def pk_flutter(
     if v_max is None:
         b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
         v_max = default_v_max(b_ref, float(abs(p0[min(1, n_modes - 1)])), v_divs)
-    v_max = check_number("v_max", v_max, unit="m/s", lo=0.0, lo_open=True)
+    v_max = check_quantity("v_max", v_max, "flight_speed")
     speeds = np.linspace(0.0, v_max, n_speeds)
-    P = np.empty((n_speeds, n_modes), dtype=complex)
-    Q = np.empty((n_speeds, am.n_q, n_modes), dtype=complex)
-    P[0], Q[0] = p0, phi
-    ended: dict[str, float] = {}
-    for j in range(n_modes):
-        for i in range(1, n_speeds):
-            guess = P[i - 1, j] if i < 2 else 2 * P[i - 1, j] - P[i - 2, j]
-            try:
-                P[i, j], Q[i, :, j] = pk.converge(
-                    speeds[i], complex(guess.real, abs(guess.imag)), Q[i - 1, :, j]
-                )
-                if abs(P[i, j] - P[i - 1, j]) > 0.3 * abs(P[i - 1, j]):
-                    raise PKConvergenceError("the p-k root jumped to another solution")
-            except PKConvergenceError:
-                # no consistent p-k root: the branch ends here (typically a heavily damped one)
-                P[i:, j] = complex(np.nan, np.nan)  # NaN frequency and damping
-                ended[f"mode {j + 1}"] = float(speeds[i])
-                break
+    P, Q, ended = track(pk, speeds, p0, phi.astype(complex), PKConvergenceError)
 
     crossings = []
     skipped: list[float] = []
@@ -246,13 +260,19 @@ def pk_flutter(
                 def re_p(v: float, k: int = k, j: int = j) -> float:
                     return pk.converge(v, P[k, j], Q[k, :, j])[0].real
 
-                if re_p(speeds[k]) * re_p(speeds[k + 1]) > 0:
-                    skipped.append(float(speeds[k]))  # the continuation did not reproduce it
+                try:
+                    if re_p(speeds[k]) * re_p(speeds[k + 1]) > 0:
+                        raise PKConvergenceError("the continuation did not reproduce it")
+                    vs = brentq(
+                        re_p, speeds[k], speeds[k + 1], xtol=rtol * speeds[k + 1], rtol=1e-15
+                    )
+                    pc = pk.converge(vs, P[k, j], Q[k, :, j])[0]
+                except PKConvergenceError:
+                    skipped.append(float(speeds[k]))
                     continue
-                vs = brentq(re_p, speeds[k], speeds[k + 1], xtol=rtol * speeds[k + 1], rtol=1e-15)
-                pc = pk.converge(vs, P[k, j], Q[k, :, j])[0]
                 kind = "onset" if g[k] < 0 else "recovery"
                 crossings.append(Crossing(float(vs), abs(pc.imag) / (2 * np.pi), j, kind))
+    warnings, restarted = _restarts(pk, boundary, crossings, P, speeds, rtol)
     crossings.sort(key=lambda c: c.speed)
     labeller = getattr(model, "label_modes", None)
     labels = labeller(basis @ phi) if labeller else [f"mode {j + 1}" for j in range(n_modes)]
@@ -267,10 +287,50 @@ def pk_flutter(
         n_states=2 * am.n_q,
         info={
             "method": "p-k, exact Theodorsen",
+            "n_modes": n_modes,
             "branches_ended_at": ended,
             "unconfirmed_sign_changes_at": skipped,
+            "restarted_at_onsets": restarted,
         },
+        warnings=warnings,
         mach=mach,
         compressibility="prandtl-glauert" if mach > 0 else None,
         damping=getattr(getattr(model, "damping", None), "describe", lambda: "none")(),
     )
+
+
+def _restarts(pk: _PK, boundary, crossings: list, P: np.ndarray, speeds: np.ndarray, rtol: float):
+    """Restart the p-k at every onset of the time-domain search; add the p-k crossings the
+    branch tracking missed. Returns the warnings and the restart records."""
+    warnings: list[str] = []
+    records: list[dict] = []
+    if boundary is None:
+        return warnings, records
+    v_max = float(speeds[-1])
+    for c in boundary.crossings:
+        if c.kind != "onset" or c.speed > v_max:
+            continue
+        found = restart(pk, c.speed, 2 * np.pi * c.frequency, v_max, rtol, PKConvergenceError)
+        rec = {"time_domain_speed": c.speed, "time_domain_frequency": c.frequency}
+        if found is None:
+            rec["pk_speed"] = None
+            records.append(rec)
+            continue
+        vs, pc, rising = found
+        f = abs(pc.imag) / (2 * np.pi)
+        rec |= {"pk_speed": vs, "pk_frequency": f}
+        records.append(rec)
+        if any(
+            abs(d.speed - vs) <= 1e-5 * vs and abs(d.frequency - f) <= 1e-4 * max(f, 1e-12)
+            for d in crossings
+        ):
+            continue
+        row = np.abs(P[int(np.argmin(np.abs(speeds - vs)))] - pc)
+        j = int(np.argmin(np.where(np.isfinite(row), row, np.inf)))
+        crossings.append(Crossing(vs, f, j, "onset" if rising else "recovery"))
+        if rising:
+            warnings.append(
+                f"p-k: the branch tracking missed the onset at {vs:.6g} m/s ({f:.4g} Hz), found "
+                f"by restarting the p-k at the time-domain onset {c.speed:.6g} m/s"
+            )
+    return warnings, records

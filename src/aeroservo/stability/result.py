@@ -283,6 +283,14 @@ class FlutterResult:
                 f"  {c.kind:<10s} {c.speed * scale:10.6g} {unit}  {c.frequency:8.5g} Hz  "
                 f"{self.mode_labels[c.mode]}"
             )
+        modal = self.info.get("modal_model", {})
+        if modal.get("enlarged"):
+            steps = modal["enlarged"]
+            lines.append(
+                f"modal model enlarged from {steps[0]['modes'][0]} to {modal['n_modes']} modes "
+                f"(band up to {modal['cutoff_hz']:.4g} Hz): "
+                + "; ".join(f"{e['by']}: {e['reason']}" for e in steps)
+            )
         lines.append(
             f"{self.n_states} states; branches: "
             + ", ".join(

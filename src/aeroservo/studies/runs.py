@@ -128,7 +128,7 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
                 v_max=fr.v_max,
             )
         else:
-            pk = pk_flutter(model, scenario.density, v_max=fr.v_max)
+            pk = pk_flutter(model, scenario.density, v_max=fr.v_max, boundary=fr)
         summary["pk_exact_theodorsen"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
