@@ -115,19 +115,26 @@ class Verifier:
         v = float(self.br.speeds[k])
         lam_r = self.br.eigenvalues[k, group]
         X0 = self.modal.lift(self.br.vectors[k][:, group])
-        lam, X, conv = self.tracker.correct_cluster(v, lam_r, X0)
-        n_q = self.tracker.n_q
-        if not conv or subspace_share(X0[:n_q], X[:n_q]).min() < CLUSTER_SHARE:
-            raise VerificationError(
-                f"the full model has no eigenvalues matching the cluster of modal branches "
-                f"{', '.join(str(i + 1) for i in group)} at {v:.6g} m/s (modal "
-                f"{complex(lam_r[0]):.6g} ...)",
-                v,
-                complex(lam_r[0]),
-            )
+        lam, X = self._cluster_pairs(v, group, lam_r, X0, "has no eigenvalues matching")
         for i, g in enumerate(group):
             self.values[k, g] = lam[i]
             self._vec[(k, g)] = X[:, i]
+
+    def _cluster_pairs(self, v: float, group: list[int], lam0, X0, failure: str) -> tuple:
+        """The full-model eigenpairs of a cluster at speed v from ``(lam0, X0)``: every one
+        converged, and every eigenvector mostly (:data:`CLUSTER_SHARE`) in the span of the
+        starting ones; else :class:`VerificationError` ("the full model <failure> ...")."""
+        lam, X, conv = self.tracker.correct_cluster(float(v), lam0, X0)
+        n_q = self.tracker.n_q
+        if not conv or subspace_share(X0[:n_q], X[:n_q]).min() < CLUSTER_SHARE:
+            raise VerificationError(
+                f"the full model {failure} the cluster of modal branches "
+                f"{', '.join(str(i + 1) for i in group)} at {v:.6g} m/s (modal "
+                f"{complex(lam0[0]):.6g} ...)",
+                float(v),
+                complex(lam0[0]),
+            )
+        return lam, X
 
     def vector(self, k: int, j: int) -> np.ndarray:
         """Full-model eigenvector of branch j at grid point k."""
@@ -156,15 +163,7 @@ class Verifier:
         if len(group) == 1:
             return self.tracker.follow(v, complex(guess[0]), self.vector(k, j), float(V[k]))[0]
         X0 = np.column_stack([self.vector(k, i) for i in group])
-        lam, X, conv = self.tracker.correct_cluster(v, guess, X0)
-        n_q = self.tracker.n_q
-        if not conv or subspace_share(X0[:n_q], X[:n_q]).min() < CLUSTER_SHARE:
-            raise VerificationError(
-                f"the cluster of branches {', '.join(str(i + 1) for i in group)} could not be "
-                f"followed on the full model to {v:.6g} m/s",
-                float(v),
-                complex(guess[group.index(j)]),
-            )
+        lam, _X = self._cluster_pairs(v, group, guess, X0, "cannot continue")
         for i, g in enumerate(group):
             self._followed.setdefault((g, k, float(v)), complex(lam[i]))
         return complex(lam[group.index(j)])
