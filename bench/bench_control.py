@@ -69,7 +69,7 @@ def bench_lqr(s: dict, repeats: int, full_ivp: bool) -> None:
     ref = run(record_states=True)
     X, Uref = ref.states, ref.applied[CONTROL]
     u_peak = np.max(np.abs(Uref))
-    on_limit = ref.saturated_fraction()[CONTROL]
+    on_limit = ref.saturated_fraction[CONTROL]
     rate_lim = np.mean(np.abs(np.diff(Uref)) >= 2e5 * DT * (1 - 1e-9))
 
     A, B, _, _ = select(plant, [CONTROL], [])

@@ -222,7 +222,7 @@ def bench_mpc(s: dict, force_opti: bool, n_baseline: int) -> None:
             f"{rec.inner.fallbacks} fallbacks; loop {r.wall_time / len(st) * 1e3:.2f} ms/step"
         )
         print(
-            f"             on limits {r.saturated_fraction()[CONTROL]:.1%} of samples, "
+            f"             on limits {r.saturated_fraction[CONTROL]:.1%} of samples, "
             f"rate-limited {rate_lim:.1%}"
         )
         if first is None:

@@ -45,3 +45,15 @@ def goland10_flutter(goland10) -> aes.FlutterResult:
 @pytest.fixture(scope="session")
 def aileron10() -> aes.AeroelasticModel:
     return aes.AeroelasticModel(aes.examples.goland_aileron(), n_elements=10)
+
+
+@pytest.fixture(autouse=True)
+def _close_pyplot_figures():
+    """Once pyplot is imported, aeroservo's figures are registered in it
+    (:mod:`aeroservo._figures`): close them after each test so they do not pile up."""
+    yield
+    import sys
+
+    plt = sys.modules.get("matplotlib.pyplot")
+    if plt is not None:
+        plt.close("all")

@@ -151,7 +151,7 @@ CORPUS = [
     ("discretize-None", lambda c: discretize(None, 100.0), "sys = None"),
     ("discretize-rate-0", lambda c: discretize(c.design, 0.0), "sample_rate = 0"),
     ("discretize-rate-tiny", lambda c: discretize(c.design, 1e-300), "sample_rate = 1e-300"),
-    ("tip-state-None", lambda c: tip_deflection_state(None, 0.01), "builder = None"),
+    ("tip-state-None", lambda c: tip_deflection_state(None, 0.01), "plant = None"),
     ("tip-state-nan", lambda c: tip_deflection_state(c.builder, NAN), "tip = nan"),
     # flutter_boundary, eigen_sweep, divergence
     (

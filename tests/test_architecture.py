@@ -23,6 +23,7 @@ BASE = (
     "aeroservo.atomic",
     "aeroservo._c_stdout",
     "aeroservo._lazy",
+    "aeroservo._figures",
 )
 ORDER = [
     "base",

@@ -554,7 +554,7 @@ def test_user_controller_equals_built_in(kind):
         run = {"duration": 0.3, "x0": loop.initial_state(0.01), "limits": limits}
         r0, r1 = simulate(plant, ctrl, **run), simulate(plant, user, **run)
         if limits is tight:
-            assert r0.saturated_fraction()[CONTROL] > 0.05
+            assert r0.saturated_fraction[CONTROL] > 0.05
         for name in ("outputs", "commands", "applied"):
             s0, s1 = getattr(r0, name), getattr(r1, name)
             assert list(s1) == list(s0)

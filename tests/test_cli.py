@@ -137,6 +137,7 @@ FLUTTER_MODULES = {
         for m in (
             "",
             ".analysis",
+            ".envelope",
             ".options",
             ".optimize",
             ".results",
@@ -156,6 +157,7 @@ FLUTTER_MODULES = {
             ".certificate",
             ".crossings",
             ".divergence",
+            ".near_critical",
             ".matched",
             ".modal",
             ".result",

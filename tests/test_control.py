@@ -238,7 +238,7 @@ def test_saturated_lqr_loses_stability_where_mpc_keeps_it(case):
         case.plant(filtered=True), M, duration=3.0, x0=case.x0(0.031, True), limits=lim
     )
     assert envelope_ratio(r_lqr.outputs["tip_disp"]) > 10.0
-    assert r_lqr.saturated_fraction()[HM] > 0.5
+    assert r_lqr.saturated_fraction[HM] > 0.5
     assert envelope_ratio(r_mpc.outputs["tip_disp"]) < 0.1
     assert np.all(np.abs(r_mpc.commands[HM]) <= 300.0 * (1 + 1e-6))
     # without the limit the same LQR is fine: the loss is due to saturation
@@ -294,9 +294,9 @@ def test_gain_schedule_widens_the_stable_range(case, K, lqr_boundary):
     np.testing.assert_allclose(mid.K, 0.5 * (S.controllers[3].K + S.controllers[4].K))
     b = closed_loop_boundary(case.pb, S, 2.0 * case.vf, reference_speed=case.V)
     ((lo_fixed, hi_fixed),) = [
-        iv for iv in lqr_boundary.stable_intervals() if iv[0] <= case.V <= iv[1]
+        iv for iv in lqr_boundary.stable_intervals if iv[0] <= case.V <= iv[1]
     ]
-    ((lo, hi),) = [iv for iv in b.stable_intervals() if iv[0] <= case.V <= iv[1]]
+    ((lo, hi),) = [iv for iv in b.stable_intervals if iv[0] <= case.V <= iv[1]]
     assert lo < lo_fixed and hi > hi_fixed
 
 

@@ -265,7 +265,7 @@ def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
             worst_freq = max(worst_freq, abs(f - f0))
         assert b.stable_at_reference
         stable = reference_intervals(expected, g[0] < 0, v_min, v_max)
-        got = b.stable_intervals()
+        got = b.stable_intervals
         assert len(got) == len(stable), what
         for (a, c), (a0, c0) in zip(got, stable, strict=True):
             assert (a, c) == pytest.approx((a0, c0), rel=1e-5), what
@@ -578,7 +578,7 @@ def test_anti_windup_bounds_the_commands_and_leaves_the_linear_loop_alone(setup,
                 plant, comp, duration=4.0, disturbance=_steady_gust, limits=tight, delay=delay
             )
         assert r.windup() == {}
-        assert r.saturated_fraction()[HM] > 0.9
+        assert r.saturated_fraction[HM] > 0.9
         assert np.max(np.abs(r.commands[HM])) < 2 * 0.2 * need
         with pytest.warns(RuntimeWarning, match="windup"):
             w = simulate(

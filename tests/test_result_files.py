@@ -132,9 +132,12 @@ def test_mode_shapes_in_metres_and_degrees(sweep, aileron10):
     fig = plot_modes(m, m["label"], m["frequency"], surfaces=saved.surfaces, modes=[0, 1])
     FigureCanvasAgg(fig).draw()
     panels = fig.axes[:2]
-    assert all(ax.get_ylabel() == "w [m]" for ax in panels)
-    assert all(ax.right.get_ylabel() == "rotation [deg]" for ax in panels)
-    flap = [ln for ln in panels[0].right.get_lines() if "aileron" in ln.get_label()][0]
+    # issue 25: each field divided by its own peak, named in m or deg in the legend
+    assert all(ax.get_ylabel() == "field / its peak [-]" for ax in panels)
+    labels = [ln.get_label() for ln in panels[0].get_lines()]
+    assert any(t.startswith("bending w / ") and t.endswith(" m") for t in labels)
+    assert any(t.startswith("twist") and t.endswith(" deg") for t in labels)
+    flap = [ln for ln in panels[0].get_lines() if "aileron" in ln.get_label()][0]
     start, end = saved.surfaces["aileron"]
     outside = (m["x"] < start - 1e-9) | (m["x"] > end + 1e-9)
     assert outside.any() and np.all(np.isnan(flap.get_ydata()[outside]))

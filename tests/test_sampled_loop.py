@@ -74,7 +74,7 @@ def test_boundary_with_delay_finds_a_stable_interval(setup):
     ctrl = controller(setup, "lqg")
     b = closed_loop_boundary(loop.plant, ctrl, 1.6 * vf, n_grid=17, delay=True)
     assert b.stable_at_reference
-    assert any(a < 1.1 * vf < c for a, c in b.stable_intervals())
+    assert any(a < 1.1 * vf < c for a, c in b.stable_intervals)
 
 
 def test_scenario_delay_reaches_the_boundary(tmp_path):
@@ -107,6 +107,6 @@ def test_stable_intervals_follow_the_crossings():
         sampled=True,
         reference_speed=5.0,
     )
-    assert b.stable_intervals() == [(0.0, 12.0), (14.0, 20.0)]
+    assert b.stable_intervals == [(0.0, 12.0), (14.0, 20.0)]
     b.crossings = [{"speed": 5.0, "frequency": 1.0, "kind": "recovery", "static": False}]
-    assert b.stable_intervals() == [(5.0, 20.0)]
+    assert b.stable_intervals == [(5.0, 20.0)]

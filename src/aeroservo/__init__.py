@@ -28,6 +28,7 @@ _PUBLIC = {
     "eigen_sweep": "stability.sweep",
     "flutter_boundary": "stability.boundary",
     "flutter_sensitivities": "stability.sensitivity",
+    "load_model": "files.wing_model",
     "load_result": "files.results",
     "save_result": "files.results",
     "statespace": "linear.models",

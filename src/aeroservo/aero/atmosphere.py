@@ -136,6 +136,23 @@ def isa(altitude: float, *, geometric: bool = False) -> Atmosphere:
     return Atmosphere(h, T, p, rho, math.sqrt(GAMMA * R_AIR * T))
 
 
+def isa_at_density(density: float) -> Atmosphere:
+    """The standard atmosphere whose density is ``density`` [kg/m^3] (the altitude clipped to
+    :data:`ALTITUDE_RANGE`): the speed of sound a density-only flight condition implies."""
+    rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+    lo, hi = ALTITUDE_RANGE
+    if rho >= isa(lo).density:
+        return isa(lo)
+    if rho <= isa(hi).density:
+        return isa(hi)
+    for _ in range(200):  # bisection: the density decreases with altitude
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if isa(mid).density > rho else (lo, mid)
+        if hi - lo < 1e-6:
+            break
+    return isa(0.5 * (lo + hi))
+
+
 def isa_slopes(atmosphere: Atmosphere, side: int = -1) -> tuple[float, float]:
     """Derivatives of density and speed of sound with geopotential altitude.
 

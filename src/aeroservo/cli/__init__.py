@@ -128,12 +128,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         if args.debug:
             raise
+        detail = " ".join(str(exc).split())  # e.g. a trade study's cases written so far
         print(
-            "aeroservo: interrupted (a run writes its files only once complete; a trade study "
-            "resumes where it stopped)",
+            f"aeroservo: interrupted: {detail}"
+            if detail
+            else "aeroservo: interrupted (a run writes its files only once complete; a trade "
+            "study resumes where it stopped)",
             file=sys.stderr,
         )
         return 130

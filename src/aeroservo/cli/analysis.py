@@ -1,4 +1,4 @@
-"""The analysis commands: ``flutter``, ``envelope`` and ``modes``."""
+"""The analysis commands: ``flutter`` and ``modes`` (and ``envelope``, :mod:`.envelope`)."""
 
 from __future__ import annotations
 
@@ -6,12 +6,15 @@ import argparse
 import json
 import sys
 
+from .envelope import add_parser as add_envelope_parser
+from .envelope import cmd_envelope
 from .options import (
     add_flight_options,
     add_model_options,
+    check_figure,
+    check_suffix,
     elements,
     named,
-    positive_float,
     positive_int,
     quantity,
     setup,
@@ -66,78 +69,26 @@ def add_parsers(sub) -> None:
         help="required damping margin drawn on the V-g plot (e.g. 0.03)",
     )
 
-    e = sub.add_parser(
-        "envelope",
-        help="flutter clearance over altitude against a V_D / M_D envelope",
-        description="Matched flutter and divergence speeds (TAS, EAS, Mach) at each altitude of "
-        "the standard atmosphere, checked against the design envelope with the margin.",
-    )
-    e.add_argument("wing", help="built-in wing, a wing .toml or a scenario .toml")
-    alt = e.add_mutually_exclusive_group(required=True)
-    alt.add_argument("--altitudes", metavar="START:STOP:STEP", help="altitudes [m], or a,b,c")
-    alt.add_argument("--altitudes-ft", metavar="START:STOP:STEP", help="altitudes [ft]")
-    e.add_argument("--vd", type=positive_float, help="design dive speed V_D, EAS (in --units)")
-    e.add_argument("--md", type=positive_float, help="design dive Mach number M_D")
-    e.add_argument(
-        "--margin", type=positive_float, default=1.15, help="margin on V_D/M_D (default 1.15)"
-    )
-    e.add_argument(
-        "--compressibility",
-        choices=("none", "prandtl-glauert"),
-        help="Prandtl-Glauert correction, Mach matched at each altitude",
-    )
-    e.add_argument("--units", choices=("si", "knots"), default="si")
-    add_model_options(e)
-    e.add_argument("--json", action="store_true", help="print one JSON object")
-    e.add_argument("--csv", metavar="FILE", help="write the table (one row per altitude)")
-    e.add_argument("--plot", metavar="FILE", help="write the envelope plot (png, pdf, svg)")
-    e.add_argument("--save", metavar="FILE.json", help="save the envelope for 'aeroservo plot'")
-    e.add_argument("--x", choices=("eas", "mach"), default="eas", help="plot axis")
-    e.add_argument(
-        "--progress",
-        action=argparse.BooleanOptionalAction,
-        default=None,
-        help="progress bar on stderr (default: when stderr is a terminal)",
-    )
+    add_envelope_parser(sub)
 
-    m = sub.add_parser("modes", help="natural frequencies of a wing (in vacuo)")
-    m.add_argument("wing")
-    m.add_argument("--elements", type=elements)
+    m = sub.add_parser(
+        "modes",
+        help="natural frequencies and mode shapes of a wing (in vacuo)",
+        description="In-vacuo natural frequencies [Hz] and mode shapes of a built-in wing or a "
+        "wing file, each mode named by its dominant motion (bending, torsion, control-surface "
+        "rotation).",
+    )
+    m.add_argument("wing", help="built-in wing (goland, goland_aileron) or a wing .toml")
+    m.add_argument(
+        "--elements", type=elements, help="beam elements (default: the wing file's, else 10)"
+    )
     m.add_argument("-n", type=positive_int, default=6, help="number of modes (default 6)")
-    m.add_argument("--json", action="store_true")
+    m.add_argument("--json", action="store_true", help="print one JSON object")
     m.add_argument("--plot", metavar="FILE", help="mode shapes figure (png, pdf, svg)")
     m.add_argument("--mode", type=positive_int, metavar="N", help="only mode N (1-based)")
     m.add_argument(
         "--animate", metavar="FILE.gif", help="animation of mode N (default 1) at the tip"
     )
-
-
-def _check_figure(path: str | None, option: str = "--plot") -> None:
-    """Refuse an unknown figure format before computing anything."""
-    if path is None:
-        return
-    from pathlib import Path
-
-    from ..atomic import check_output_path
-    from ..errors import InputError
-
-    fmt = Path(path).suffix.lstrip(".").lower()
-    if fmt not in ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff", "webp"):
-        raise InputError(f"{option} = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
-    check_output_path(path, option)
-
-
-def _check_suffix(option: str, path: str | None, suffix: str) -> None:
-    if path is None:
-        return
-    from pathlib import Path
-
-    from ..atomic import check_output_path
-    from ..errors import InputError
-
-    if Path(path).suffix.lower() != suffix:
-        raise InputError(f"{option} = {path!r}: expected a {suffix} file name")
-    check_output_path(path, option)
 
 
 def _wing_text(spec: str, wing) -> str:
@@ -155,9 +106,9 @@ def _wing_text(spec: str, wing) -> str:
 
 
 def _cmd_flutter(args: argparse.Namespace) -> int:
-    _check_figure(args.plot)
-    _check_suffix("--save", args.save, ".npz")
-    _check_suffix("--table", args.table, ".csv")
+    check_figure(args.plot)
+    check_suffix("--save", args.save, ".npz")
+    check_suffix("--table", args.table, ".csv")
     s = setup(args)
     from ..stability.boundary import flutter_boundary
 
@@ -197,6 +148,11 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
             )
         else:
             pk = pk_flutter(model, s.density, boundary=result, **kw)
+        from ..stability.near_critical import method_discrepancy
+
+        note = method_discrepancy(result, pk, model.semichord, model.wagner.name)
+        if note and note not in pk.warnings:  # the matched (altitude) path
+            pk.warnings.append(note)
         out["pk_exact_theodorsen"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
@@ -253,97 +209,13 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_envelope(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from ..aero.atmosphere import KNOT
-    from ..atomic import atomic_write_set, figure_writer
-    from ..files.summaries import json_text
-    from ..studies.envelope import flutter_envelope, parse_altitudes
-
-    _check_figure(args.plot)
-    _check_suffix("--save", args.save, ".json")
-    _check_suffix("--csv", args.csv, ".csv")
-    alts = parse_altitudes(args.altitudes_ft, "ft") if args.altitudes_ft else None
-    alts = alts or parse_altitudes(args.altitudes)
-    s = setup(args, altitudes=True)
-    vd = None if args.vd is None else args.vd * (KNOT if args.units == "knots" else 1.0)
-    progress = sys.stderr.isatty() if args.progress is None else args.progress
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=len(alts), desc="envelope", unit="altitude", leave=False)
-    try:
-        env = flutter_envelope(
-            s.model,
-            alts,
-            compressibility=s.compressibility,
-            vd=vd,
-            md=args.md,
-            margin=args.margin,
-            progress=(lambda i: bar.update(1)) if bar is not None else None,
-        )
-    finally:
-        if bar is not None:
-            bar.close()
-    items = []
-    if args.csv:
-        items.append((Path(args.csv), lambda p: p.write_text(env.csv_text(args.units))))
-    if args.plot:
-        fig = env.plot(units=args.units, x=args.x)
-        items.append((Path(args.plot), figure_writer(fig, args.plot, dpi=150)))
-    if args.save:
-        text = json_text({"format": "aeroservo-envelope-1", **env.to_dict()})
-        items.append((Path(args.save), lambda p: p.write_text(text, encoding="utf-8")))
-    atomic_write_set(items)
-    for p in env.points:
-        for w in p.warnings:
-            print(f"aeroservo: warning: {p.altitude:g} m: {w}", file=sys.stderr)
-    if args.json:
-        print(json_text(env.to_dict()))
-        return 0
-    print(_envelope_text(env, args.units))
-    for kind, path in (("table", args.csv), ("plot", args.plot), ("envelope", args.save)):
-        if path:
-            print(f"{kind} written to {path}")
-    return 0
-
-
-def _envelope_text(env, units: str) -> str:
-    from ..aero.atmosphere import KNOT
-
-    k = 1 / KNOT if units == "knots" else 1.0
-    u = "kt" if units == "knots" else "m/s"
-
-    def f(v, fmt="8.4g"):
-        return f"{'-':>8s}" if v is None else f"{v:{fmt}}"
-
-    comp = env.compressibility or "incompressible"
-    lines = [f"{env.wing}: flutter envelope ({comp}; structural damping {env.damping})"]
-    head = f"  {'alt [m]':>8s} {'VF TAS':>8s} {'VF EAS':>8s} {'MF':>8s} {'VD EAS':>8s}"
-    if env.envelope:
-        head += f" {'req EAS':>8s}  margin"
-    lines += [head + f"   (speeds in {u})"]
-    for p in env.points:
-        row = f"  {p.altitude:8.0f} {f(p.flutter_speed and p.flutter_speed * k)}"
-        row += f" {f(p.flutter_eas and p.flutter_eas * k)} {f(p.flutter_mach, '8.3f')}"
-        row += f" {f(p.divergence_eas and p.divergence_eas * k)}"
-        if env.envelope:
-            row += f" {f(p.required_eas * k)}  {'ok' if p.margin_ok else 'FAIL'}"
-        lines.append(row)
-    if env.envelope:
-        lines.append(f"  clearance with margin {env.margin:g}: {'ok' if env.margin_ok else 'FAIL'}")
-    return "\n".join(lines)
-
-
 def _cmd_modes(args: argparse.Namespace) -> int:
     from ..errors import InputError, check_int
     from ..files.wing_file import resolve_wing
     from ..system.aeroelastic import AeroelasticModel
 
-    _check_figure(args.plot)
-    _check_suffix("--animate", args.animate, ".gif")
+    check_figure(args.plot)
+    check_suffix("--animate", args.animate, ".gif")
     wing, opts = resolve_wing(args.wing)
     with named("n_elements", "--elements" if args.elements else None, args, "elements"):
         model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
@@ -375,7 +247,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 def _mode_figures(args: argparse.Namespace, model, modes) -> None:
     """The ``--plot`` and ``--animate`` files of ``aeroservo modes`` (written as a set)."""
     from ..atomic import atomic_write_set, figure_writer
-    from ..plots.modes import gif_writer, plot_modes
+    from ..plots.modes import gif_writer, plot_modes, strain_energy_shares
 
     fields = model.mode_fields(modes.shapes)
     cols = [args.mode - 1] if args.mode else list(range(modes.frequencies.size))
@@ -383,8 +255,15 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
     writers = []
     title = f"{model.wing.name}: {model.n_elements} elements, in-vacuo natural modes"
     if args.plot:
+        shares = strain_energy_shares(model, modes.shapes)
         fig = plot_modes(
-            fields, modes.labels, modes.frequencies, surfaces=surfaces, modes=cols, title=title
+            fields,
+            modes.labels,
+            modes.frequencies,
+            surfaces=surfaces,
+            modes=cols,
+            title=title,
+            shares=shares,
         )
         writers.append((args.plot, figure_writer(fig, args.plot, dpi=130)))
     if args.animate:
@@ -396,4 +275,4 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
         print(f"written {path}", file=sys.stderr)
 
 
-HANDLERS = {"flutter": _cmd_flutter, "envelope": _cmd_envelope, "modes": _cmd_modes}
+HANDLERS = {"flutter": _cmd_flutter, "envelope": cmd_envelope, "modes": _cmd_modes}

@@ -24,13 +24,59 @@ def add_parsers(sub) -> None:
         default="analytic",
         help="analytic sensitivities (default) or central differences, for comparison",
     )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="write the optimum into DIR (created): FILE-stem_wing.toml (a wing file for "
+        "'aeroservo flutter'), _history.csv (one row per iterate) and _convergence.png",
+    )
+
+
+def _out_dir(text: str | None):
+    """The ``--out`` folder, checked before the optimization runs (None: not given)."""
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    if text is None:
+        return None
+    if not text.strip():
+        raise InputError("--out = '': give an output folder")
+    out = Path(text)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out = {text!r}: is a file, expected a folder")
+    return out
+
+
+def _write(op, r, out, source: str) -> dict:
+    """The optimum's files, all or none (the folder created only now)."""
+    from ..atomic import atomic_write_set
+    from ..files.optimize_file import optimum_writers
+
+    items = optimum_writers(op, r, out, source)
+    created = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        atomic_write_set(list(items.values()))
+    except BaseException:
+        if created and not any(out.iterdir()):
+            out.rmdir()
+        raise
+    return {k: str(path) for k, (path, _w) in items.items()}
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
+    from ..errors import InputError
     from ..files.optimize_file import load_optimization
     from ..files.toml_tables import read_toml
 
+    out = _out_dir(args.out)
     if "codesign" in read_toml(args.file):
+        if out is not None:
+            raise InputError(
+                f"--out = {args.out!r}: writes the wing of an optimization file; the optimum "
+                f"of the co-design file {args.file} is a trade case (printed)"
+            )
         return _codesign(args)
     op = load_optimization(args.file)
     from ..studies.optimize import optimize_wing
@@ -46,10 +92,12 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         v_max=op.v_max,
         gradients=args.gradients,
     )
+    files = _write(op, r, out, args.file) if out is not None else {}
     if args.json:
         from ..files.summaries import json_text
 
-        print(json_text({"name": op.name, "gradients": args.gradients, **r.to_dict()}))
+        extra = {"files": files} if files else {}
+        print(json_text({"name": op.name, "gradients": args.gradients, **r.to_dict(), **extra}))
         return 0 if r.success else 1
     print(
         f"{op.name}: {r.message} ({len(r.iterations)} designs analysed, "
@@ -61,6 +109,8 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         f"  objective {r.objective:.6g}; flutter {r.flutter_speed} m/s, divergence "
         f"{r.divergence_speed} m/s (fresh analysis); active: {', '.join(r.active) or 'none'}"
     )
+    for kind, path in files.items():
+        print(f"  wrote {kind}: {path}")
     return 0 if r.success else 1
 
 

@@ -252,3 +252,31 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
     with named("n_elements", option, args, "elements"):
         model = AeroelasticModel(wing, elements, wagner, damping=_damping(args, opts.damping))
     return Setup(wing, model, atm, density, comp, opts)
+
+
+def check_figure(path: str | None, option: str = "--plot") -> None:
+    """Refuse an unknown figure format before computing anything."""
+    if path is None:
+        return
+    from pathlib import Path
+
+    from ..atomic import check_output_path
+    from ..errors import InputError
+
+    fmt = Path(path).suffix.lstrip(".").lower()
+    if fmt not in ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff", "webp"):
+        raise InputError(f"{option} = {path!r}: unknown figure format {fmt!r}; use png, pdf or svg")
+    check_output_path(path, option)
+
+
+def check_suffix(option: str, path: str | None, suffix: str) -> None:
+    if path is None:
+        return
+    from pathlib import Path
+
+    from ..atomic import check_output_path
+    from ..errors import InputError
+
+    if Path(path).suffix.lower() != suffix:
+        raise InputError(f"{option} = {path!r}: expected a {suffix} file name")
+    check_output_path(path, option)

@@ -37,8 +37,9 @@ def add_parsers(sub) -> None:
         help="redraw a saved result: flutter sweep, simulation, trade study or envelope",
         description="Redraw a result: a sweep saved by 'aeroservo flutter --save' (kinds vg, "
         "vf, root-locus, modes, flutter-mode), a simulation written by 'aeroservo simulate' "
-        "(time), a trade study's folder (pareto, heatmap) or an envelope saved by 'aeroservo "
-        "envelope --save' (envelope).",
+        "(time), a trade study's folder (pareto, heatmap: --metric and --slice choose the "
+        "metric and the other parameters' values) or an envelope saved by 'aeroservo envelope "
+        "--save' (envelope).",
     )
     pl.add_argument("result", help="result file (.npz, envelope .json) or trade folder")
     pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
@@ -54,6 +55,18 @@ def add_parsers(sub) -> None:
     pl.add_argument("--eas", action="store_true", help="equivalent airspeed on the speed axis")
     pl.add_argument(
         "--g-required", type=quantity("structural_g"), metavar="G", help="required damping g"
+    )
+    pl.add_argument(
+        "--metric",
+        metavar="NAME",
+        help="trade-study heat map: the metric (default: suppression_margin; implies --kind "
+        "heatmap)",
+    )
+    pl.add_argument(
+        "--slice",
+        metavar="P=V[,P=V]",
+        help="trade-study heat map: hold parameters at values of the grid, e.g. "
+        "bryson_hinge_moment=500 (default: one panel per value, or the best case's values)",
     )
 
     ex = sub.add_parser(
@@ -80,7 +93,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from ..errors import InputError
     from ..files.results import load_result
     from ..files.user_files import check_readable
-    from .analysis import _check_figure
+    from .options import check_figure
 
     src = Path(args.result)
     if not src.is_dir():
@@ -92,14 +105,19 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if gif and args.kind not in ("modes", "flutter-mode"):
         raise InputError(f"--out = {str(out)!r}: a .gif animates --kind modes or flutter-mode")
     if not gif:
-        _check_figure(str(out), "--out")
+        check_figure(str(out), "--out")
     else:
         from ..atomic import check_output_path
 
         check_output_path(out, "--out")
     res = load_result(src)
     what, kinds = _what(res)
-    kind = args.kind or kinds[0]
+    heat = args.metric is not None or args.slice is not None
+    kind = args.kind or ("heatmap" if heat and "heatmap" in kinds else kinds[0])
+    if heat and kind != "heatmap":
+        raise InputError(
+            f"--metric and --slice apply to the heat map of a trade study, not to --kind {kind}"
+        )
     if kind not in kinds:
         raise InputError(f"--kind = {kind!r}: {args.result} is {what}; use {', '.join(kinds)}")
     if gif:
@@ -113,7 +131,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     elif kind == "envelope":
         fig = res.plot(units=args.units)
     else:
-        fig = res.pareto() if kind == "pareto" else res.heatmap()
+        fig = res.pareto() if kind == "pareto" else _heatmap(res, args)
     save_figure(fig, out, dpi=130)
     print(f"plot written to {out}")
     return 0
@@ -146,6 +164,61 @@ def _animate_saved(saved, args: argparse.Namespace, out) -> int:
     atomic_write(out, gif_writer(fields, j, wing, label=label, frequency=freq))
     print(f"animation written to {out}")
     return 0
+
+
+def _heatmap(res, args: argparse.Namespace):
+    """A trade study's heat map of ``--metric`` on ``--slice`` (one-line errors that list the
+    valid names and values)."""
+    from ..errors import InputError
+    from ..studies.trade.study import METRICS
+
+    if args.metric is not None and args.metric not in METRICS:
+        raise InputError(
+            f"--metric = {args.metric!r}: not a trade-study metric; valid are {', '.join(METRICS)}"
+        )
+    fixed = _slice(args.slice, res.parameters) if args.slice is not None else {}
+    free = [n for n in res.parameters if n not in fixed]
+    if len(free) < 2:
+        raise InputError(
+            f"--slice = {args.slice!r}: a heat map needs two parameters left free; this study "
+            f"sweeps {', '.join(res.parameters)}"
+        )
+    return res.heatmap(args.metric, **fixed)
+
+
+def _slice(text: str, parameters: dict) -> dict:
+    """``--slice P=V[,P=V]``: each P a swept parameter, each V one of its values."""
+    import math
+
+    from ..errors import InputError
+
+    names = ", ".join(parameters)
+    out: dict = {}
+    for item in text.split(","):
+        name, sep, value = (t.strip() for t in item.partition("="))
+        if not sep or not name or not value:
+            example = next(iter(parameters))
+            raise InputError(
+                f"--slice = {text!r}: expected PARAM=VALUE[,PARAM=VALUE], e.g. "
+                f"{example}={parameters[example][0]:g}; parameters are {names}"
+            )
+        if name not in parameters:
+            raise InputError(f"--slice: {name!r} is not a swept parameter; swept are {names}")
+        if name in out:
+            raise InputError(f"--slice = {text!r}: {name} given twice")
+        grid = parameters[name]
+        values = ", ".join(f"{g:g}" for g in grid)
+        try:
+            v = float(value)
+        except ValueError:
+            v = math.nan
+        match = [g for g in grid if math.isclose(v, g, rel_tol=1e-9, abs_tol=1e-12)]
+        if not match:
+            raise InputError(
+                f"--slice {name} = {value!r}: not a value of the study; its values are {values}"
+            )
+        out[name] = float(match[0])
+    return out
 
 
 def _what(res) -> tuple[str, tuple]:

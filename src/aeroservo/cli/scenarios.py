@@ -255,8 +255,14 @@ def _readable(s: dict) -> str:
             from ..studies.trade.study import PARAMETERS
 
             params = ", ".join(f"{k} = {b[k]:g}" for k in PARAMETERS if k in b)
+            bound = "suppression_margin" not in b  # stable to the end of the search
+            margin = (
+                b["closed_loop_v_max"] / b["open_loop_flutter_speed"] - 1.0
+                if bound
+                else b["suppression_margin"]
+            )
             lines.append(
-                f"  best suppression margin {b['suppression_margin']:+.1%} ({params}): "
+                f"  best suppression margin {'>= ' if bound else ''}{margin:+.1%} ({params}): "
                 f"open loop {f(b['open_loop_flutter_speed'], ' m/s')}, closed loop "
                 f"{f(b.get('closed_loop_flutter_speed'), ' m/s')}, peak hinge moment "
                 f"{f(b.get('hinge_moment_peak'), ' N m')} in the gust"

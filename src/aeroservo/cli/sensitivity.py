@@ -33,9 +33,9 @@ def add_parsers(sub) -> None:
 
 def _cmd_sensitivity(args: argparse.Namespace) -> int:
     from ..errors import check_int
-    from .analysis import _check_figure
+    from .options import check_figure
 
-    _check_figure(args.plot)
+    check_figure(args.plot)
     check_int("--top", args.top, lo=1, hi=1000)
     s = setup(args)
     from ..stability.sensitivity import flutter_sensitivities

@@ -98,11 +98,12 @@ class ClosedLoopBoundary:
     def lower_speed(self) -> float | None:
         """Lower end [m/s] of the stable interval that holds the reference speed (None if the
         loop is unstable there); the start of the searched range if stable down to it."""
-        for a, b in self.stable_intervals():
+        for a, b in self.stable_intervals:
             if a <= self.reference_speed <= b:
                 return a
         return None
 
+    @property
     def stable_intervals(self) -> list[tuple[float, float]]:
         """Speed intervals [m/s] inside the searched range where the loop is stable.
 
@@ -180,7 +181,7 @@ class ClosedLoopBoundary:
             "delay": self.delay,
             "law": self.info.get("law", ""),
             "crossings": self.crossings,
-            "stable_intervals": self.stable_intervals(),
+            "stable_intervals": self.stable_intervals,
             "unstable_intervals": self.unstable_intervals(),
             "v_range": list(self.v_range),
         }
@@ -204,11 +205,17 @@ class ClosedLoopBoundary:
             Speed range [m/s] where the loop is engaged (shaded).
         stable_to : float, optional
             Speed [m/s] up to which stability is required (the flutter margin), marked.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            ``ax``'s figure, or a new one: the current pyplot figure when pyplot is in use
+            (:mod:`aeroservo._figures`), so ``plt.savefig`` and ``plt.show()`` act on it.
         """
-        from matplotlib.figure import Figure
+        from .._figures import new_figure
 
         if ax is None:
-            fig = Figure(layout="constrained", figsize=(7.5, 4.0))
+            fig = new_figure(figsize=(7.5, 4.0))
             ax = fig.subplots()
         else:
             fig = ax.figure

@@ -1,7 +1,7 @@
 """User files: TOML tables and their validation (:mod:`.toml_tables`), wing, controller and
-scenario files (:mod:`.wing_file`, :mod:`.controller_file`, :mod:`.scenario_file`), result
-files (:mod:`.results`), the outputs of a run written as a set (:mod:`.outputs`) and
-state-space exports (:mod:`.statespace_export`).
+scenario files (:mod:`.wing_file`, :mod:`.controller_file`, :mod:`.scenario_file`), a wing file
+as one model (:mod:`.wing_model`), result files (:mod:`.results`), the outputs of a run written
+as a set (:mod:`.outputs`) and state-space exports (:mod:`.statespace_export`).
 """
 
 from .._lazy import lazy_attributes
@@ -9,7 +9,9 @@ from .._lazy import lazy_attributes
 _PUBLIC = {
     "export_mat": "statespace_export",
     "export_npz": "statespace_export",
+    "WingModel": "wing_model",
     "load_controller": "controller_file",
+    "load_model": "wing_model",
     "load_result": "results",
     "load_scenario": "scenario_file",
     "load_wing": "wing_file",
@@ -19,9 +21,11 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "WingModel",
     "export_mat",
     "export_npz",
     "load_controller",
+    "load_model",
     "load_result",
     "load_scenario",
     "load_wing",

@@ -10,6 +10,7 @@ aeroservo version. No pickled objects: a damaged or foreign file gives one clear
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import zipfile
@@ -20,6 +21,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
+from ..stability.near_critical import NearCritical
 from ..stability.result import Crossing, FlutterResult
 from .summaries import json_text
 from .user_files import MAX_RESULT_BYTES, read_bytes
@@ -106,6 +108,9 @@ def _sweep_arrays(prefix: str, r: FlutterResult) -> dict:
 def _sweep_meta(r: FlutterResult) -> dict:
     meta = {k: getattr(r, k) for k in _SCALARS}
     meta.update(mode_labels=list(r.mode_labels), warnings=list(r.warnings), info=r.info)
+    meta["near_critical"] = [
+        {**dataclasses.asdict(n), "speed_range": list(n.speed_range)} for n in r.near_critical
+    ]
     return meta
 
 
@@ -223,10 +228,26 @@ def _sweep_from(data: dict, meta: dict, prefix: str, path: Path) -> FlutterResul
             exact=exact,
             warnings=[str(w) for w in meta.get("warnings", [])],
             info=dict(meta.get("info") or {}),
+            near_critical=[_near_critical(n, lam.shape[1]) for n in meta.get("near_critical", [])],
             **scalars,
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{path}: header of the flutter result is not valid ({exc})") from None
+
+
+def _near_critical(n: dict, n_modes: int) -> NearCritical:
+    lo, hi = (float(v) for v in n["speed_range"])
+    mode = int(n["mode"])
+    if not 0 <= mode < n_modes:
+        raise ValueError(f"near_critical mode {mode} out of range")
+    return NearCritical(
+        float(n["speed"]),
+        float(n["frequency"]),
+        float(n["damping_ratio"]),
+        (lo, hi),
+        mode,
+        float(n["threshold"]),
+    )
 
 
 def read_flutter(path: Path, data: dict, meta: dict) -> SavedFlutter:

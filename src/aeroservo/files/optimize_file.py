@@ -23,6 +23,11 @@ flutter_speed_min = 150.0
 [damping]                # optional: structural damping, as in a wing file (g, ratio, alpha/beta)
 g = 0.02
 ```
+
+``aeroservo optimize FILE --out DIR`` writes the optimum as a set (:func:`optimum_writers`):
+``<stem>_wing.toml`` (a wing file with the file's density, elements, ``v_max`` and damping in
+``[analysis]`` and ``[damping]``: ``aeroservo flutter`` on it repeats the optimum's fresh
+analysis), ``<stem>_history.csv`` (one row per SLSQP iterate) and ``<stem>_convergence.png``.
 """
 
 from __future__ import annotations
@@ -34,7 +39,34 @@ from ..errors import MAX_ELEMENTS, InputError
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
 from .wing_file import damping_from_dict, wing_from_dict
 
-__all__ = ["OptimizationFile", "CoDesignFile", "load_optimization", "load_codesign"]
+__all__ = [
+    "OptimizationFile",
+    "CoDesignFile",
+    "load_optimization",
+    "load_codesign",
+    "optimum_writers",
+]
+
+UNITS = {
+    "segment": {
+        "mass": "kg/m",
+        "x_alpha": "-",
+        "inertia": "kg m",
+        "EI": "N m^2",
+        "GJ": "N m^2",
+        "a": "-",
+        "semichord": "m",
+    },
+    "surface": {
+        "hinge": "-",
+        "static_moment": "kg m/m",
+        "inertia": "kg m",
+        "GJ": "N m^2",
+        "hinge_stiffness": "N m/rad/m",
+    },
+    "actuator": {"stiffness": "N m/rad", "station": "m"},
+}
+"""Units of the design variables (wing-file keys by owner, ``docs/wing-file.md``)."""
 
 
 @dataclass(frozen=True)
@@ -153,3 +185,123 @@ def load_codesign(path: str | Path) -> CoDesignFile:
             variables=variables,
             hinge_moment_peak_max=cons.number("hinge_moment_peak_max", quantity="limit"),
         )
+
+
+def _num(x: float | None) -> str:
+    return "" if x is None else repr(float(x))
+
+
+def _wing_text(op: OptimizationFile, result, source: str) -> str:
+    """The optimum as a wing file that ``aeroservo flutter`` reads with the same model."""
+    from dataclasses import replace
+
+    from .._version import __version__
+    from ..studies.optimize import with_parameters
+    from .wing_file import wing_toml
+
+    wing = with_parameters(op.wing, result.variables)
+    wing = replace(wing, name=f"{op.wing.name} (optimum of {Path(source).name})")
+    state = "converged" if result.success else "NOT converged"
+    lines = [
+        f"# Optimum of {source} ({op.name}), aeroservo {__version__} 'optimize --out'.",
+        f"# SLSQP {state}: {result.message}",
+        f"# Fresh analysis of this wing: flutter speed {_num(result.flutter_speed) or 'none'} m/s, "
+        f"divergence speed {_num(result.divergence_speed) or 'none'} m/s; active: "
+        f"{', '.join(result.active) or 'none'}.",
+        *(f"#   {n} = {v!r} (start {result.start[n]!r})" for n, v in result.variables.items()),
+        "# Run again: aeroservo flutter <this file>",
+        "",
+        wing_toml(wing).rstrip("\n"),
+        "",
+        "[analysis]",
+        f"density = {_num(op.density)}",
+        f"elements = {op.elements}",
+    ]
+    if op.v_max is not None:
+        lines.append(f"v_max = {_num(op.v_max)}")
+    d = op.damping.to_dict() if op.damping is not None and op.damping.active else {}
+    if d:
+        lines += ["", "[damping]"]
+        for k, v in d.items():
+            if k != "kind":
+                lines.append(
+                    f"{k} = " + (f"[{', '.join(map(_num, v))}]" if k == "ratio" else _num(v))
+                )
+    return "\n".join(lines) + "\n"
+
+
+def _history_csv(op: OptimizationFile, result) -> str:
+    """One row per SLSQP iterate: variables (units in the header), objective, speeds,
+    constraint margins ``speed / bound - 1`` (>= 0: met), designs and boundaries so far."""
+    import csv
+    import io
+
+    from ..stability.sensitivity import parameter_values
+
+    table = parameter_values(op.wing)
+    names = list(result.variables)
+    units = {n: UNITS[table[n][0]][table[n][2]] for n in names}
+    objective = "objective [m/s]" if op.objective == "flutter_speed" else "objective"
+    cons = list(result.constraints)
+    header = [
+        "iteration",
+        *(f"{n} [{units[n]}]" for n in names),
+        objective,
+        "flutter_speed [m/s]",
+        "divergence_speed [m/s]",
+        *(f"{c} margin [-]" for c in cons),
+        "designs_analysed",
+        "flutter_boundaries",
+    ]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for h in result.history:
+        w.writerow(
+            [
+                h["iteration"],
+                *(_num(h["variables"][n]) for n in names),
+                _num(h["objective"]),
+                _num(h["flutter_speed"]),
+                _num(h["divergence_speed"]),
+                *(_num(h["constraints"][c]) for c in cons),
+                h["designs_analysed"],
+                h["n_boundaries"],
+            ]
+        )
+    return buf.getvalue()
+
+
+def optimum_writers(op: OptimizationFile, result, out_dir: str | Path, source: str) -> dict:
+    """The files of ``optimize --out``: ``{kind: (path, writer)}`` for
+    :func:`aeroservo.atomic.atomic_write_set` (kinds ``wing``, ``history``, ``convergence``).
+
+    Parameters
+    ----------
+    op : OptimizationFile
+    result : Optimization
+        From :func:`aeroservo.studies.optimize.optimize_wing` on ``op``.
+    out_dir : str or Path
+        Output folder (must exist when written).
+    source : str
+        The optimization file's path: its stem names the files.
+    """
+    from .._figures import detached
+    from ..atomic import figure_writer
+    from ..studies.optimize_plot import plot_convergence
+
+    out, stem = Path(out_dir), Path(source).stem
+    wing = _wing_text(op, result, source)
+    csv_text = _history_csv(op, result)
+    with detached():  # written to a file, not left in pyplot
+        fig = plot_convergence(result, op.variables, op.objective, title=op.name)
+    png = out / f"{stem}_convergence.png"
+
+    def text(t: str):
+        return lambda p: p.write_text(t, encoding="utf-8")
+
+    return {
+        "wing": (out / f"{stem}_wing.toml", text(wing)),
+        "history": (out / f"{stem}_history.csv", text(csv_text)),
+        "convergence": (png, figure_writer(fig, png, dpi=120)),
+    }

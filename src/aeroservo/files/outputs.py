@@ -4,18 +4,19 @@ A flutter run writes ``<result>.json`` and ``<result>_vg.png``; a simulation wri
 ``<result>.npz`` (:mod:`aeroservo.files.results`), ``<result>.png``, ``<result>_margins.png``
 (Nyquist, Bode, S and T at the actuator), ``<result>_boundary.png`` (closed-loop stability over
 speed, the engaged range shaded) and ``<result>_margin_sweep.png`` (margins across the engaged
-range) for a controlled linear loop, and
-``<result>.json``; a trade study writes
-
-``summary.json``, ``heatmap.png`` and ``pareto.png`` into its folder (next to its case store,
-CSV and NetCDF). Every file of a run is renamed into place only when all of them have been
-written (:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
+range) for a controlled linear loop, and ``<result>.json``; a trade study writes
+``summary.json``, ``heatmap_<metric>.png`` (one per metric of
+:data:`aeroservo.studies.trade.plots.HEATMAP_METRICS`) and ``pareto.png`` into its folder
+``<result>/`` (next to its case store, ``<result>.csv`` and ``<result>.nc``). Every file of a
+run is renamed into place only when all of them have been written
+(:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from .._figures import detached
 from ..atomic import atomic_write_set, figure_writer
 from ..studies.runs import Run
 from .results import result_writer
@@ -40,7 +41,12 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
     out_dir : str or Path
         Output folder (must exist); a trade study writes into its own folder ``run.folder``.
     """
-    out = Path(out_dir)
+    with detached():  # figures written to files, not left in pyplot nor shown in a notebook
+        return _write_run(run, Path(out_dir))
+
+
+def _write_run(run: Run, out: Path) -> dict[str, str]:
+    """:func:`write_run` into the folder ``out``."""
     sc = run.scenario
     summary = run.summary
     items: list = []
@@ -64,7 +70,8 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
         add("result", npz, result_writer(run.simulation, dict(summary)))
         if plots:
             png = out / f"{sc.result}.png"
-            add("plot", png, figure_writer(run.simulation.plot(), png, dpi=120))
+            fig = run.simulation.plot(open_loop=run.open_loop)
+            add("plot", png, figure_writer(fig, png, dpi=120))
             judged = getattr(run.judgement, "boundary", None)
             boundary = run.boundary if run.boundary is not None else judged
             if boundary is not None:
@@ -95,15 +102,9 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
     else:
         res, folder = run.trade, run.folder
         files["csv"], files["netcdf"] = str(res.csv_path), str(res.netcdf_path)
-        ok = res.table[res.table["status"] == "ok"]
-        if plots and len(ok):
-            names = list(res.parameters)
-            if len(names) >= 2:
-                png = folder / "heatmap.png"
-                fig = res.heatmap("suppression_margin", names[0], names[1])
-                add("heatmap", png, figure_writer(fig, png, dpi=120))
-            png = folder / "pareto.png"
-            add("pareto", png, figure_writer(res.pareto(), png, dpi=120))
+        for name, fig in res.figures().items() if plots else ():
+            png = folder / name
+            add(png.stem, png, figure_writer(fig, png, dpi=120))
         json_path = folder / "summary.json"
     summary["files"] = files
     items.append((json_path, _text_writer(json_text(summary))))

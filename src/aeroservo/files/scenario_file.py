@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import MAX_ELEMENTS, InputError
+from ..simulate.march import MAX_SAMPLES
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .scenario_checks import cross_check
@@ -218,6 +219,14 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["expect_failure"] = sim.boolean("expect_failure", sim.boolean("expect_unstable", False))
     kw["duration"] = sim.number("duration", 2.0, quantity="duration")
     kw["sample_rate"] = sim.number("sample_rate", 1000.0, quantity="sample_rate")
+    n_samples = round(kw["duration"] * kw["sample_rate"]) + 1
+    if n_samples > MAX_SAMPLES:
+        sim.fail(
+            "duration",
+            kw["duration"],
+            f"{n_samples} samples at simulation.sample_rate = {kw['sample_rate']:g} Hz, above "
+            f"the limit of {MAX_SAMPLES} samples; shorten the run or lower the sample rate",
+        )
     kw["delay"] = sim.boolean("delay", False)
     kw["seed"] = sim.integer("seed", 0, lo=0, hi=2**32 - 1)
     kw["sensor_noise"] = sim.number_map("sensor_noise", quantity="variance")

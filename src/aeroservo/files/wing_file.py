@@ -10,6 +10,7 @@ the key and the value.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -233,7 +234,11 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
         _check_keys("(top level)", data, ("wing",), ("analysis", "damping"))
         opts = analysis_from_dict(data.get("analysis", {}))
         if "damping" in data:
-            opts = replace(opts, damping=damping_from_dict(data["damping"]))
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                opts = replace(opts, damping=damping_from_dict(data["damping"]))
+            for w in caught:  # the file's name in front of the key
+                warnings.warn(f"{path}: {w.message}", w.category, stacklevel=2)
         return wing_from_dict(data["wing"]), opts
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None

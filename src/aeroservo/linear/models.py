@@ -8,7 +8,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..aero.atmosphere import isa_at_density
 from ..errors import RANGES, InputError, check_number
+from ..system.first_order import mach_note
 from .signals import Sensor, describe
 from .state_space import DENSITIES, MAX_SPEED, Servo, StateSpaceBuilder, _tag
 
@@ -113,7 +115,14 @@ def statespace(
     b = _builder_for(
         model, density, inputs, outputs, servo=servo, gust=gust, kussner=kussner, n_modes=n_modes
     )
-    return b.at(speed, balanced=balanced)
+    note = mach_note("the model", speed, isa_at_density(density).speed_of_sound, assumed=True)
+    if note:
+        import warnings
+
+        warnings.warn(note, UserWarning, stacklevel=2)
+    sys = b.at(speed, balanced=balanced)
+    sys.builder = b  # the plant's layout, for tip_deflection_state and state maps
+    return sys
 
 
 def statespace_family(
@@ -150,26 +159,57 @@ def discretize(sys, sample_rate: float):
     return d
 
 
-def tip_deflection_state(builder, tip: float, *, balanced: bool = True) -> np.ndarray:
+def tip_deflection_state(plant, tip: float, *, balanced: bool | None = None) -> np.ndarray:
     """Initial state: the static shape under a tip load, scaled to a tip deflection ``tip`` [m].
 
-    Rates, lag, gust and servo states are zero. ``builder`` is the plant's
-    :class:`~aeroservo.linear.state_space.StateSpaceBuilder` (full model); ``balanced``
-    (default, as its models): in the scaled states of ``builder.at``; False: physical states.
+    Rates, lag, gust and servo states are zero.
+
+    Parameters
+    ----------
+    plant : control.StateSpace or StateSpaceBuilder
+        The plant from :func:`statespace` (its states, balanced or physical, are used as they
+        are) or its :class:`~aeroservo.linear.state_space.StateSpaceBuilder` (full model).
+    tip : float
+        Tip deflection [m] (+ up).
+    balanced : bool, optional
+        With a builder: the scaled states of ``builder.at`` (default True) or the physical
+        ones (False). With a state space it must agree with the model's states if given.
+
+    Returns
+    -------
+    ndarray (n_states,)
     """
+    builder = getattr(plant, "builder", plant)
     if not isinstance(builder, StateSpaceBuilder):
-        raise InputError(f"builder = {describe(builder)}: expected a StateSpaceBuilder")
+        raise InputError(
+            f"plant = {describe(plant)}: expected the control.StateSpace of "
+            "aeroservo.statespace(...) or a StateSpaceBuilder"
+        )
     check_number("tip", tip, unit="m")
-    _check_bool("balanced", balanced)
+    if balanced is not None:
+        _check_bool("balanced", balanced)
     if builder.n_modes is not None:
-        raise InputError("tip_deflection_state: use the full-model builder of the plant")
+        raise InputError("tip_deflection_state: use the full-model plant (no n_modes)")
     model = builder.model
     f = np.zeros(model.n_dofs)
     f[model.mesh.dof_w[-1]] = 1.0
     q = np.linalg.solve(model.matrices.Ks.toarray(), f)
     x = np.zeros(builder.n_states)
     x[: model.n_dofs] = q * (tip / q[model.mesh.dof_w[-1]])
-    return x / builder.state_scaling if balanced else x
+    if builder is plant:
+        return x / builder.state_scaling if balanced in (None, True) else x
+    scaling = np.asarray(plant.state_scaling)
+    is_balanced = not np.all(scaling == 1.0)
+    if (
+        balanced is not None
+        and bool(balanced) != is_balanced
+        and not np.all(builder.state_scaling == 1.0)
+    ):
+        raise InputError(
+            f"balanced = {balanced}: the plant's states are "
+            f"{'balanced' if is_balanced else 'physical'}; leave balanced out"
+        )
+    return x / scaling
 
 
 def _check_bool(field: str, value: object) -> bool:

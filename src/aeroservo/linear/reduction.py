@@ -275,10 +275,10 @@ class FRFComparison:
 
     def plot(self, output: str, input: str):
         """Bode magnitude of one channel, full and reduced (matplotlib Figure)."""
-        from matplotlib.figure import Figure
+        from .._figures import new_figure
 
         i, j = self.outputs.index(output), self.inputs.index(input)
-        fig = Figure(layout="constrained", figsize=(6.5, 4))
+        fig = new_figure(figsize=(6.5, 4))
         ax = fig.subplots()
         f = self.omega / (2 * np.pi)
         ax.loglog(f, np.abs(self.full[i, j]), label="full")

@@ -210,7 +210,7 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
             out.append(OutputDef(spec.name, "sensor", QUANTITIES[spec.quantity][1], sensor=spec))
             continue
         if not isinstance(spec, str):
-            raise InputError(f"output {spec!r}: expected a name or an aeroservo.Sensor")
+            raise InputError(f"output {describe(spec)}: expected a name or an aeroservo.Sensor")
         m = _TIP.match(spec)
         if m:
             edge, q = m.groups()
@@ -232,10 +232,11 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
             continue
         m = _MODAL.match(spec)
         if m:
-            k = int(m.group(1))
+            digits = m.group(1).lstrip("0") or "0"
+            k = int(digits) if len(digits) <= 9 else n_modes_available + 1  # no huge int()
             if not 1 <= k <= n_modes_available:
                 raise InputError(
-                    f"output {spec!r}: mode number must be in [1, {n_modes_available}]"
+                    f"output {describe(spec)}: mode number must be in [1, {n_modes_available}]"
                 )
             out.append(OutputDef(spec, "modal", "kg^0.5 m", index=k - 1))
             continue
@@ -262,7 +263,7 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
                 + [f"{s}_{{deflection,rate,aero_hinge_moment,actuator_moment}}" for s in surfaces]
             )
             raise InputError(
-                f"output {spec!r}: unknown sensor; known outputs: {names}, or a Sensor"
+                f"output {describe(spec)}: unknown sensor; known outputs: {names}, or a Sensor"
             )
     _no_duplicates([d.name for d in out], "outputs")
     return out

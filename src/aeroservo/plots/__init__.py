@@ -1,8 +1,12 @@
 """Figures of single results: V-g / V-f diagrams, root loci, flutter envelopes (:mod:`.flutter`),
 mode shapes and their animation (:mod:`.modes`) and loop margins (:mod:`.margins`).
 
-Functions return :class:`matplotlib.figure.Figure` objects built without ``pyplot`` (no GUI
-backend needed; they display inline in notebooks and save with ``fig.savefig``).
+Functions return :class:`matplotlib.figure.Figure` objects made by
+:func:`aeroservo._figures.new_figure`: when pyplot is in use (imported) the figure is the current
+pyplot figure (``plt.gcf()``, ``plt.savefig``, ``plt.show()`` act on it) and a notebook shows it
+once, also when it is the cell's last value; otherwise a detached figure (no GUI backend
+needed), saved with ``fig.savefig``. Angles are drawn in degrees (labels say ``[deg]``); the
+results, their files and the API keep radians.
 """
 
 from .._lazy import lazy_attributes

@@ -1,7 +1,8 @@
 """Figures of open-loop results: V-g / V-f diagrams, root locus, mode shapes, flutter envelope.
 
-Functions return :class:`matplotlib.figure.Figure` objects built without ``pyplot`` (no GUI
-backend needed; they display inline in notebooks and save with ``fig.savefig``).
+Functions return :class:`matplotlib.figure.Figure` objects made by
+:func:`aeroservo._figures.new_figure` (the current pyplot figure when pyplot is in use, shown
+once in a notebook; detached otherwise).
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._figures import new_figure
 from ..errors import check_quantity
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -19,12 +21,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..stability.result import FlutterResult
 
 __all__ = ["plot_vg", "plot_root_locus", "plot_envelope", "select_modes"]
-
-
-def _figure(**kw) -> Figure:
-    from matplotlib.figure import Figure
-
-    return Figure(layout="constrained", **kw)
 
 
 AUTO_FMAX = 3.0
@@ -85,11 +81,16 @@ def plot_vg(
 ) -> Figure:
     """V-f (top) and V-g (bottom) diagrams of the tracked modes, flutter point marked.
 
-    ``g = -2 zeta`` (positive: unstable). Divergence, when inside the range, is a dashed line.
+    ``g = -2 zeta`` (positive: unstable). Divergence, when inside the range, is a dashed
+    vertical line labelled with its speed; it is marked at 0 Hz only where a drawn branch is
+    overdamped there (a real root through zero), never on the V-g panel (a real root has no g).
     Where a branch is overdamped (a pair of real roots) it is drawn dotted at 0 Hz on the V-f
-    panel and left out of the V-g panel (its g is not a structural damping); the line is broken
+    panel (legend "overdamped" only then) and left out of the V-g panel; the line is broken
     there, so a branch that becomes oscillatory again is not joined to its earlier stretch.
-    The damping axis spans every drawn point; the legend sits outside the panels.
+    Crossings are marked on drawn branches only. Near-critical branches (a damping ratio that
+    comes within :data:`aeroservo.stability.near_critical.NEAR_ZETA` of zero without crossing)
+    are shaded over their speed range and marked at their minimum. The damping axis spans every
+    drawn point; the legend sits outside the panels.
 
     Parameters
     ----------
@@ -122,13 +123,15 @@ def plot_vg(
     scale = (1 / KNOT if units == "knots" else 1.0) * (
         np.sqrt(result.density / RHO0) if eas else 1.0
     )
-    fig = _figure(figsize=(8.2, 6.5))
+    fig = new_figure(figsize=(8.2, 6.5))
     ax_f, ax_g = fig.subplots(2, 1, sharex=True)
     V = result.speeds * scale
     f = result.frequencies
     g = -2.0 * result.damping_ratio
     drawn_g = [np.zeros(1)]
-    for j in select_modes(result, fmax, modes):
+    drawn = select_modes(result, fmax, modes)
+    overdamped = np.zeros(result.eigenvalues.shape, dtype=bool)  # drawn at 0 Hz
+    for j in drawn:
         lam = result.eigenvalues[:, j]
         osc = _oscillatory(lam)
         lab = f"{j + 1}: {result.mode_labels[j]}"
@@ -137,12 +140,13 @@ def plot_vg(
         real = np.isfinite(lam) & ~osc
         if real.any():
             ax_f.plot(V, np.where(real, 0.0, np.nan), ":", lw=2.0, color=line.get_color())
+            overdamped[:, j] = real
         drawn_g.append(g[osc, j])
     if pk is not None:
         same = len(pk.mode_labels) == len(result.mode_labels)
-        drawn = select_modes(result, fmax, modes) if same else select_modes(pk, fmax, modes)
+        pk_drawn = drawn if same else select_modes(pk, fmax, modes)
         pk_osc = _oscillatory(pk.eigenvalues)
-        pk_osc[:, [j for j in range(pk_osc.shape[1]) if j not in drawn]] = False
+        pk_osc[:, [j for j in range(pk_osc.shape[1]) if j not in pk_drawn]] = False
         Vp = np.broadcast_to(pk.speeds[:, None] * scale, pk.eigenvalues.shape)
         gp = -2.0 * pk.damping_ratio
         ax_f.plot(Vp[pk_osc], pk.frequencies[pk_osc], "x", color="0.35", ms=4, label="p-k")
@@ -152,8 +156,9 @@ def plot_vg(
             fp = pk.flutter
             ax_g.plot(fp.speed * scale, 0.0, "X", color="k", ms=8, label="p-k flutter")
             ax_f.plot(fp.speed * scale, fp.frequency, "X", color="k", ms=8)
-    ax_f.plot([], [], ":", color="0.4", lw=2.0, label="overdamped (real roots)")
-    left_out = len(result.mode_labels) - len(select_modes(result, fmax, modes))
+    if overdamped.any():
+        ax_f.plot([], [], ":", color="0.4", lw=2.0, label="overdamped (real roots)")
+    left_out = len(result.mode_labels) - len(drawn)
     if left_out:
         ax_f.plot([], [], " ", label=f"{left_out} more mode{'s' * (left_out > 1)} not drawn")
     ax_g.axhline(0.0, color="k", lw=0.8)
@@ -162,12 +167,28 @@ def plot_vg(
         label = f"g = -{g_required:g} (required damping)"
         ax_g.axhline(-g_required, color="r", lw=0.9, ls="--", label=label)
     for c in result.crossings:
-        marker = "o" if c.kind == "onset" else ("s" if c.kind == "recovery" else "D")
-        mfc = "none" if c.kind != "onset" else "r"
+        if c.mode not in drawn:
+            continue
+        if c.kind == "divergence":  # at 0 Hz only on a drawn overdamped stretch
+            k = int(np.argmin(np.abs(result.speeds - c.speed)))
+            if overdamped[k, c.mode]:
+                ax_f.plot(c.speed * scale, 0.0, "D", color="k", ms=6, mfc="none")
+            continue
+        marker, mfc = ("o", "r") if c.kind == "onset" else ("s", "none")
         ax_g.plot(c.speed * scale, 0.0, marker, color="k", ms=6, mfc=mfc)
         ax_f.plot(c.speed * scale, c.frequency, marker, color="k", ms=6, mfc=mfc)
     fl = result.flutter
     unit = ("kt" if units == "knots" else "m/s") + (" EAS" if eas else "")
+    for n in getattr(result, "near_critical", ()):  # stable, but within the threshold
+        lo, hi = (v * scale for v in n.speed_range)
+        label = (
+            f"near-critical {lo:.4g}-{hi:.4g} {unit}\n{n.frequency:.3g} Hz, "
+            f"g up to {-2 * n.damping_ratio:.1e}"
+        )
+        for ax in (ax_f, ax_g):
+            ax.axvspan(lo, hi, color="tab:orange", alpha=0.18, lw=0)
+        ax_g.plot(n.speed * scale, -2 * n.damping_ratio, "v", color="tab:orange", ms=7, label=label)
+        ax_f.plot(n.speed * scale, n.frequency, "v", color="tab:orange", ms=7)
     if fl is not None:
         ax_g.plot([], [], "o", color="k", mfc="r", label=f"flutter {fl.speed * scale:.4g} {unit}")
         ax_g.annotate(
@@ -181,8 +202,15 @@ def plot_vg(
     if vd is not None and vd <= V[-1]:
         for ax in (ax_f, ax_g):
             ax.axvline(vd, color="k", ls="--", lw=0.8)
+        right = vd > V[0] + 0.6 * (V[-1] - V[0])  # the label on the side with room
         ax_f.text(
-            vd, 0.98, " divergence", va="top", fontsize=8, transform=ax_f.get_xaxis_transform()
+            vd,
+            0.98,
+            f" divergence \n V_div = {vd:.4g} {unit} ",
+            va="top",
+            ha="right" if right else "left",
+            fontsize=8,
+            transform=ax_f.get_xaxis_transform(),
         )
     ax_f.set_ylabel("frequency [Hz]")
     ax_g.set_ylabel(r"$g = -2\zeta$ [-]  (> 0 unstable)")
@@ -199,7 +227,7 @@ def plot_vg(
     labels = [t for ax in (ax_f, ax_g) for t in ax.get_legend_handles_labels()[1]]
     fig.legend(handles, labels, loc="outside right upper", fontsize=8)
     condition = result.condition_text().replace("; ", "\n", 1)
-    fig.suptitle((title + "\n" if title else "V-g / V-f\n") + condition, fontsize=9)
+    ax_f.set_title((title + "\n" if title else "V-g / V-f\n") + condition, fontsize=9)
     return fig
 
 
@@ -224,7 +252,7 @@ def plot_envelope(envelope, *, units: str = "si", x: str = "eas") -> Figure:
         from ..errors import InputError
 
         raise InputError(f"x = {x!r}: allowed values are 'eas', 'mach'")
-    fig = _figure(figsize=(6.5, 5.5))
+    fig = new_figure(figsize=(6.5, 5.5))
     ax = fig.subplots()
     h = envelope.altitudes / 1000.0
     scale = 1 / KNOT if units == "knots" else 1.0
@@ -291,7 +319,7 @@ def plot_root_locus(
     from ..aero.atmosphere import KNOT
 
     scale = 1 / KNOT if units == "knots" else 1.0
-    fig = _figure(figsize=(6.5, 5.0))
+    fig = new_figure(figsize=(6.5, 5.0))
     ax = fig.subplots()
     V = result.speeds * scale
     sc = None

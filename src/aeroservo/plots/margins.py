@@ -7,19 +7,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._figures import new_figure
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from ..design.margin_sweep import MarginSweep
     from ..design.margins import LoopMargins
 
-__all__ = ["plot_loop_margins", "plot_margin_sweep"]
+__all__ = ["plot_loop_margins", "plot_margin_sweep", "BODE_RANGE_DB"]
 
-
-def _figure(**kw) -> Figure:
-    from matplotlib.figure import Figure
-
-    return Figure(layout="constrained", **kw)
+BODE_RANGE_DB = 100.0
+"""The Bode magnitude axis spans this many dB below the larger of the peak ``|L|`` and 0 dB
+(a loop gain far below that does not matter to the margins); the phase is not drawn there."""
 
 
 def _disk(ax, size: float, **kw) -> None:
@@ -33,10 +33,16 @@ def _disk(ax, size: float, **kw) -> None:
     ax.fill(c + r * np.cos(t), r * np.sin(t), **kw)
 
 
-def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: str | None = None):
+def plot_loop_margins(
+    margins: LoopMargins, control: str | None = None, title: str | None = None
+) -> Figure:
     """Nyquist diagram (left, zoomed on -1), broken-loop Bode diagram and the sensitivity ``S``
     and complementary sensitivity ``T`` at the plant input (right) of one control channel, with
     its gain, phase and disk margins, the requirement and the break point.
+
+    ``L`` is the sampled loop's return ratio ``L(exp(j omega T))`` from 0 to the Nyquist
+    frequency ``pi / T`` (its mirror image, dashed, closes the Nyquist contour). The Bode
+    magnitude axis spans :data:`BODE_RANGE_DB` below its peak (or 0 dB); phases in degrees.
 
     Parameters
     ----------
@@ -48,7 +54,7 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
     control = control or next(iter(margins.channels))
     ch = margins.channels[control]
     req = margins.requirement
-    fig = _figure(figsize=(11.5, 7.0))
+    fig = new_figure(figsize=(11.5, 7.0))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.25])
     ax_n = fig.add_subplot(grid[:, 0])
     ax_m = fig.add_subplot(grid[0, 1])
@@ -76,8 +82,13 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
         alpha=0.15,
         label=f"disk margin alpha = {ch.disk_margin:.3g}",
     )
-    ax_n.plot(L.real, L.imag, "C0", lw=1.2, label=r"$L(e^{j\omega\Delta t})$, 0 to Nyquist")
-    ax_n.plot(L.real, -L.imag, "C0", lw=0.8, ls="--", alpha=0.6)
+    label = (
+        rf"$L(e^{{j\omega T}})$, loop broken at {control}"
+        + "\n"
+        + rf"$\omega$ = 0 to $\pi/T$ (Nyquist), T = {margins.dt * 1e3:.4g} ms"
+    )
+    ax_n.plot(L.real, L.imag, "C0", lw=1.2, label=label)
+    ax_n.plot(L.real, -L.imag, "C0", lw=0.8, ls="--", alpha=0.6, label=r"mirror ($\omega < 0$)")
     u = np.linspace(0, 2 * np.pi, 200)
     ax_n.plot(np.cos(u), np.sin(u), color="0.6", lw=0.8, ls=":")
     ax_n.plot(-1, 0, "r+", ms=12, mew=2)
@@ -97,9 +108,14 @@ def plot_loop_margins(margins: LoopMargins, control: str | None = None, title: s
 
     # Bode of the return ratio
     keep = f > 0
-    ax_m.semilogx(f[keep], 20 * np.log10(np.maximum(np.abs(L[keep]), 1e-300)), "C0")
+    db = 20 * np.log10(np.maximum(np.abs(L[keep]), 1e-300))
+    top = max(float(db.max()), 0.0)
+    floor = max(float(db.min()), top - BODE_RANGE_DB)
+    ax_m.semilogx(f[keep], db, "C0")
+    ax_m.set_ylim(floor - 0.05 * (top - floor) - 1.0, top + 0.1 * (top - floor) + 1.0)
     ax_m.axhline(0, color="k", lw=0.8)
-    ax_p.semilogx(f[keep], np.degrees(np.angle(-L[keep])), "C0")
+    phase = np.where(db >= floor, np.degrees(np.angle(-L[keep])), np.nan)
+    ax_p.semilogx(f[keep], phase, "C0")
     ax_p.axhline(0, color="k", lw=0.8)
     marks = (
         (ch.gain_frequencies[0], f"gain reduction {ch.gain_reduction_margin_db:.3g} dB", "C3"),
@@ -152,14 +168,16 @@ def _sensitivity(ax, margins: LoopMargins) -> None:
     ax.legend(fontsize=7, loc="lower left")
 
 
-def plot_margin_sweep(sweep: MarginSweep, control: str | None = None, title: str | None = None):
+def plot_margin_sweep(
+    sweep: MarginSweep, control: str | None = None, title: str | None = None
+) -> Figure:
     """Gain (both ways), phase and disk margins of one channel versus airspeed, with the
     requirement; speeds where the loop is unstable are shaded."""
     control = control or sweep.controls[0]
     t = sweep.table(control)
     req = sweep.requirement
     v = sweep.speeds
-    fig = _figure(figsize=(7.5, 7.0))
+    fig = new_figure(figsize=(7.5, 7.0))
     ax_g, ax_p, ax_d = fig.subplots(3, 1, sharex=True)
 
     def finite(a, cap):

@@ -1,10 +1,14 @@
 """Mode-shape figures and animations: natural modes and the flutter mode along the span.
 
 A mode is given as nodal fields (:meth:`aeroservo.system.aeroelastic.AeroelasticModel.
-nodal_fields`): bending ``w`` [m], twist ``phi`` [rad] and flap rotations ``delta_<surface>``
-[rad] at the stations ``x`` [m], normalised so that the largest deflection or rotation is 1
-(in m or rad). Bending is drawn in metres on the left axis, twist and flap rotation in degrees
-on the right one; a flap rotation only over its surface.
+mode_fields`): bending ``w`` [m], twist ``phi`` [rad] and flap rotations ``delta_<surface>``
+[rad] (relative to the wing) at the stations ``x`` [m]. A deflection and a rotation are not
+comparable, so each field is drawn divided by its own peak over the span (its peak, in m or
+deg, is in the legend) and a mode's make-up is given by its share of strain energy per kind of
+deformation when the model is known (:func:`strain_energy_shares`; the same measure names the
+modes, :meth:`~aeroservo.system.aeroelastic.AeroelasticModel.label_modes`). A complex mode (the
+flutter mode) is drawn as magnitude and phase [deg] along the span, the phase relative to one
+reference point named on the axis. A flap rotation is drawn over its surface only.
 """
 
 from __future__ import annotations
@@ -14,10 +18,22 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._figures import detached, new_figure
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["plot_mode_shapes", "plot_modes", "animate_mode", "gif_writer"]
+__all__ = [
+    "plot_mode_shapes",
+    "plot_modes",
+    "strain_energy_shares",
+    "animate_mode",
+    "gif_writer",
+    "PHASE_FLOOR",
+]
+
+PHASE_FLOOR = 0.02
+"""The phase of a field is not drawn where its magnitude is below this share of its peak."""
 
 
 def _on_surface(x: np.ndarray, y: np.ndarray, span: Sequence[float] | None) -> np.ndarray:
@@ -27,33 +43,112 @@ def _on_surface(x: np.ndarray, y: np.ndarray, span: Sequence[float] | None) -> n
     return np.where(inside, y, np.nan)
 
 
-def _align_zero(ax1, ax2) -> None:
-    """Put zero at the same height on both axes of a panel (extending a lower limit)."""
-    lims = [[min(a.get_ylim()[0], 0.0), max(a.get_ylim()[1], 0.0)] for a in (ax1, ax2)]
-    frac = [-lo / (hi - lo) if hi > lo else 0.5 for lo, hi in lims]
-    f = max(frac)
-    if f > 0.95:
-        return
-    for ax, (lo, hi) in zip((ax1, ax2), lims, strict=True):
-        ax.set_ylim(min(lo, -f / (1 - f) * hi), hi)
+def _name(key: str) -> tuple[str, str, float]:
+    """Legend name, unit and scale to that unit of a field (rotations in degrees)."""
+    if key == "w":
+        return "bending w", "m", 1.0
+    if key == "phi":
+        return "twist \u03c6", "deg", np.degrees(1.0)
+    return f"{key[len('delta_') :]} rotation \u03b4", "deg", np.degrees(1.0)
 
 
-def _panel(ax, x, fields: dict, j: int, surfaces: dict, part: str, style: str) -> list:
-    """Draw one mode (column j, real or imaginary part) on ``ax`` and a twin axis."""
-    get = np.real if part == "real" else np.imag
-    suffix = "" if part == "real" else " (imag.)"
-    ax2 = ax.right if hasattr(ax, "right") else ax.twinx()
-    ax.right = ax2
-    lines = ax.plot(x, get(fields["w"][:, j]), "C0" + style, label="bending w [m]" + suffix)
-    lines += ax2.plot(
-        x, np.degrees(get(fields["phi"][:, j])), "C1" + style, label="twist [deg]" + suffix
-    )
-    for k, key in enumerate(k for k in fields if k.startswith("delta_")):
-        name = key[len("delta_") :]
-        y = _on_surface(x, np.degrees(get(fields[key][:, j])), surfaces.get(name))
-        lines += ax2.plot(x, y, f"C{k + 2}" + style, label=f"{name} rotation [deg]" + suffix)
-    ax.set_ylabel("w [m]")
-    ax2.set_ylabel("rotation [deg]")
+def strain_energy_shares(model, shapes: np.ndarray) -> dict[str, np.ndarray]:
+    """Share of each mode's strain energy by kind of deformation, keyed like the nodal fields.
+
+    ``"w"``: bending (EI w''^2), ``"phi"``: torsion (GJ phi'^2), ``"delta_<surface>"``: the
+    surface's hinge springs, actuators and own torsion; each (n_modes,), summing to 1. The
+    measure :meth:`~aeroservo.system.aeroelastic.AeroelasticModel.label_modes` names modes by
+    (for a natural mode the kinetic energy splits the same way).
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    shapes : ndarray (n_q, n_modes)
+        Mode shapes (real or complex).
+    """
+    shapes = np.asarray(shapes)
+    key = {"bending": "w", "torsion": "phi"}
+    energy = {}
+    for name, k in model.matrices.stiffness_parts.items():
+        field = key.get(name) or "delta_" + name[len("flap (") : -1]
+        energy[field] = np.real(np.einsum("ij,ij->j", shapes.conj(), np.asarray(k @ shapes)))
+    total = sum(energy.values())
+    total = np.where(total > 0, total, 1.0)
+    return {k: e / total for k, e in energy.items()}
+
+
+def _fields(fields: dict, j: int, surfaces: dict) -> dict[str, np.ndarray]:
+    """Column j of each field (flap rotations over their surface only, NaN elsewhere)."""
+    out = {}
+    for key in fields:
+        if key == "w" or key == "phi" or key.startswith("delta_"):
+            y = np.asarray(fields[key][:, j])
+            span = surfaces.get(key[len("delta_") :]) if key.startswith("delta_") else None
+            out[key] = _on_surface(fields["x"], y, span)
+    return out
+
+
+def _share_text(shares: dict | None, j: int) -> str:
+    if not shares:
+        return ""
+    parts = sorted(((float(v[j]), k) for k, v in shares.items()), reverse=True)
+    kind = {"w": "bending", "phi": "torsion"}
+    named = [f"{kind.get(k, k[len('delta_') :])} {v:.0%}" for v, k in parts if v >= 0.005]
+    return "\nstrain energy: " + ", ".join(named)
+
+
+def _legend(key: str, peak: float) -> str:
+    name, unit, scale = _name(key)
+    return f"{name} / {peak * scale:.3g} {unit}"
+
+
+def _real_panel(ax, x, cols: dict) -> list:
+    """Each field of a real mode divided by its peak."""
+    lines = []
+    for k, (key, y) in enumerate(cols.items()):
+        peak = float(np.nanmax(np.abs(y))) if np.any(np.isfinite(y)) else 0.0
+        if peak == 0.0:
+            continue
+        lines += ax.plot(x, y / peak, f"C{k}-", label=_legend(key, peak))
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_ylim(-1.08, 1.08)
+    ax.set_ylabel("field / its peak [-]")
+    return lines
+
+
+def _reference(cols: dict, shares: dict | None, j: int) -> tuple[str, int]:
+    """The field and station the phase is measured from: the peak of the field with the largest
+    energy share, or (without shares) the largest value of the mode as scaled."""
+    if shares:
+        key = max((k for k in cols if k in shares), key=lambda k: shares[k][j])
+    else:
+        key = max(cols, key=lambda k: np.nanmax(np.abs(cols[k])))
+    return key, int(np.nanargmax(np.abs(cols[key])))
+
+
+def _complex_panels(ax_m, ax_p, x, cols: dict, shares: dict | None, j: int) -> list:
+    """Magnitude (each field divided by its peak) and phase [deg] of a complex mode."""
+    ref_key, i_ref = _reference(cols, shares, j)
+    ref = cols[ref_key][i_ref]
+    lines = []
+    for k, (key, y) in enumerate(cols.items()):
+        mag = np.abs(y)
+        peak = float(np.nanmax(mag)) if np.any(np.isfinite(mag)) else 0.0
+        if peak == 0.0:
+            continue
+        with np.errstate(invalid="ignore"):
+            phase = np.degrees(np.angle(y / ref))
+        at_peak = phase[int(np.nanargmax(mag))]
+        label = f"{_legend(key, peak)}, phase {at_peak:+.0f} deg at its peak"
+        lines += ax_m.plot(x, mag / peak, f"C{k}-", label=label)
+        ax_p.plot(x, np.where(mag >= PHASE_FLOOR * peak, phase, np.nan), f"C{k}-")
+    ax_m.set_ylim(0.0, 1.08)
+    ax_m.set_ylabel("|field| / its peak [-]")
+    ax_p.set_ylim(-190.0, 190.0)
+    ax_p.set_yticks([-180, -90, 0, 90, 180])
+    ax_p.axhline(0.0, color="0.6", lw=0.6)
+    name = _name(ref_key)[0]
+    ax_p.set_ylabel(f"phase [deg]\nrel. to {name}\nat x = {x[i_ref]:.3g} m", fontsize=8)
     return lines
 
 
@@ -65,15 +160,24 @@ def plot_modes(
     surfaces: dict | None = None,
     modes: Sequence[int] | None = None,
     title: str | None = None,
+    shares: dict | None = None,
 ) -> Figure:
-    """Panels of mode shapes along the span, one per mode.
+    """Panels of mode shapes along the span, one per mode (two for a complex mode).
+
+    Each field (bending w, twist, flap rotation) is divided by its own peak over the span; the
+    legend gives the peaks (in m and deg, for the mode as scaled in ``fields``); with
+    ``shares``, each title lists the mode's strain energy by kind of deformation. Complex
+    fields (the flutter mode) are drawn as magnitude and phase [deg] relative to the peak of
+    the field with the largest energy share (without ``shares``: to the largest value of the
+    mode as scaled, where ``fields`` makes the mode real); the phase is left out where a field
+    is below :data:`PHASE_FLOOR` of its peak.
 
     Parameters
     ----------
     fields : dict
         Nodal fields (:meth:`~aeroservo.system.aeroelastic.AeroelasticModel.mode_fields`, or a
-        saved result's ``modes``); complex fields (the
-        flutter mode) are drawn as real (solid) and imaginary (dashed) parts.
+        saved result's ``modes``): ``x`` [m], ``w`` [m], ``phi`` and ``delta_<surface>`` [rad],
+        each (n_nodes, n_modes).
     labels, frequencies : sequence
         Name and frequency [Hz] of each column.
     surfaces : dict, optional
@@ -81,37 +185,50 @@ def plot_modes(
     modes : sequence of int, optional
         Columns to draw (0-based; default all).
     title : str, optional
+    shares : dict, optional
+        ``{field: (n_columns,) array}`` of strain-energy shares (:func:`strain_energy_shares`).
     """
-    from ..plots.flutter import _figure
-
     surfaces = surfaces or {}
     cols = list(range(fields["w"].shape[1])) if modes is None else list(modes)
-    fig = _figure(figsize=(8.2, 2.3 * len(cols) + 0.6))
-    axes = np.atleast_1d(fig.subplots(len(cols), 1, sharex=True))
+    cplx = np.iscomplexobj(fields["w"])
+    rows = 2 * len(cols) if cplx else len(cols)
+    heights = [1.0, 0.7] * len(cols) if cplx else None
+    fig = new_figure(figsize=(8.6, (2.0 if cplx else 2.3) * rows + 0.6))
+    axes = np.atleast_1d(fig.subplots(rows, 1, sharex=True, height_ratios=heights))
     x = fields["x"]
-    for ax, j in zip(axes, cols, strict=True):
-        lines = _panel(ax, x, fields, j, surfaces, "real", "-")
-        if np.iscomplexobj(fields["w"]):
-            lines += _panel(ax, x, fields, j, surfaces, "imag", "--")
-        _align_zero(ax, ax.right)
-        ax.set_title(f"{labels[j]}  {frequencies[j]:.4g} Hz", fontsize=9)
+    for n, j in enumerate(cols):
+        col = _fields(fields, j, surfaces)
+        head = f"{labels[j]}  {frequencies[j]:.4g} Hz" + _share_text(shares, j)
+        if cplx:
+            ax, ax_p = axes[2 * n], axes[2 * n + 1]
+            lines = _complex_panels(ax, ax_p, x, col, shares, j)
+            ax_p.grid(True, alpha=0.3)
+        else:
+            ax = axes[n]
+            lines = _real_panel(ax, x, col)
+        ax.set_title(head, fontsize=9)
         ax.grid(True, alpha=0.3)
-        ax.legend(handles=lines, fontsize=7, loc="upper left", bbox_to_anchor=(1.12, 1.0))
+        ax.legend(handles=lines, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1].set_xlabel("spanwise station x [m]")
-    fig.suptitle(
-        (title + "\n" if title else "")
-        + "normalised: largest deflection or rotation = 1 (m or rad)",
-        fontsize=9,
-    )
+    note = "each field divided by its own peak (in the legend)"
+    if shares:
+        note += "; the mode is named by its largest share of strain energy"
+    if cplx:
+        note = "magnitude: " + note + "; phase [deg] relative to the point named on the axis"
+    fig.suptitle((title + "\n" if title else "") + note, fontsize=9)
     return fig
 
 
 def plot_mode_shapes(model, modes, *, n: int = 4) -> Figure:
-    """The first ``n`` natural modes of a model (``modes``: :class:`NaturalModes`)."""
+    """The first ``n`` natural modes of a model (``modes``: :class:`NaturalModes`), with their
+    strain-energy shares."""
     n = min(n, modes.shapes.shape[1])
     fields = model.mode_fields(modes.shapes[:, :n])
     surfaces = {cs.name: (cs.start, cs.end) for cs in model.wing.control_surfaces}
-    return plot_modes(fields, modes.labels[:n], modes.frequencies[:n], surfaces=surfaces)
+    shares = strain_energy_shares(model, modes.shapes[:, :n])
+    return plot_modes(
+        fields, modes.labels[:n], modes.frequencies[:n], surfaces=surfaces, shares=shares
+    )
 
 
 def animate_mode(
@@ -147,14 +264,12 @@ def animate_mode(
     """
     from matplotlib.animation import FuncAnimation
 
-    from ..plots.flutter import _figure
-
     w = complex(fields["w"][-1, j])
     phi = complex(fields["phi"][-1, j])
     keys = [k for k in fields if k.startswith("delta_")]
     delta = complex(fields[keys[0]][-1, j]) if keys and hinge is not None else 0j
     amp = 0.25 * semichord / max(abs(w), abs(phi) * semichord, abs(delta) * semichord, 1e-12)
-    fig = _figure(figsize=(6.0, 3.6))
+    fig = new_figure(figsize=(6.0, 3.6))
     ax = fig.subplots()
     b, a = semichord, elastic_axis
     lim = 1.3 * b
@@ -199,13 +314,14 @@ def gif_writer(fields: dict, j: int, wing, *, label: str, frequency: float):
 
     tip = wing.segments[-1]
     cs = [c for c in wing.control_surfaces if c.end >= wing.span - 1e-9]
-    _, anim = animate_mode(
-        fields,
-        j,
-        label=label,
-        frequency=frequency,
-        semichord=tip.semichord,
-        elastic_axis=tip.a,
-        hinge=cs[0].hinge if cs else None,
-    )
+    with detached():  # written to a file, not shown
+        _, anim = animate_mode(
+            fields,
+            j,
+            label=label,
+            frequency=frequency,
+            semichord=tip.semichord,
+            elastic_axis=tip.a,
+            hinge=cs[0].hinge if cs else None,
+        )
     return lambda p: anim.save(p, writer=PillowWriter(fps=20))

@@ -6,6 +6,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._figures import new_figure
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
@@ -28,8 +30,6 @@ def plot_sensitivities(s: FlutterSensitivities, *, top: int = 20, title: str = "
     -------
     matplotlib.figure.Figure
     """
-    from matplotlib.figure import Figure
-
     flutter = s.normalized() if s.d_flutter_speed else {}
     div = (
         {k: s.values[k] * d / s.divergence_speed for k, d in s.d_divergence_speed.items()}
@@ -40,7 +40,7 @@ def plot_sensitivities(s: FlutterSensitivities, *, top: int = 20, title: str = "
         set(flutter) | set(div), key=lambda k: -max(abs(flutter.get(k, 0.0)), abs(div.get(k, 0.0)))
     )
     names = names[:top][::-1]
-    fig = Figure(figsize=(8.0, 1.2 + 0.32 * max(len(names), 1)), layout="constrained")
+    fig = new_figure(figsize=(8.0, 1.2 + 0.32 * max(len(names), 1)))
     ax = fig.add_subplot()
     y = np.arange(len(names))
     h = 0.4 if div and flutter else 0.7

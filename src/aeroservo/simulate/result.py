@@ -9,10 +9,52 @@ import numpy as np
 from ..design.plant import Limits
 from ..errors import InputError
 
-__all__ = ["SimulationResult", "WINDUP_RATIO", "windup_text"]
+__all__ = ["SimulationResult", "WINDUP_RATIO", "windup_text", "LIMIT_SHOWN", "OPEN_LOOP_SCALE"]
 
 WINDUP_RATIO = 10.0
 """A command beyond this many times its magnitude limit is reported as winding up."""
+
+
+LIMIT_SHOWN = 3.0
+"""A magnitude limit is drawn on the time-history figure when it is within this many times the
+signal's peak; otherwise it is named in the panel ("off scale")."""
+
+OPEN_LOOP_SCALE = 2.0
+"""An open-loop overlay is drawn up to where it leaves this many times the closed loop's peak."""
+
+
+def _display_unit(unit: str) -> tuple[float, str]:
+    """Factor and unit a signal is drawn in: angles in degrees, the rest as recorded."""
+    if unit == "rad":
+        return float(np.degrees(1.0)), "deg"
+    if unit.startswith("rad/"):
+        return float(np.degrees(1.0)), "deg/" + unit[len("rad/") :]
+    return 1.0, unit
+
+
+def _overlay(ax, t: np.ndarray, y_open: np.ndarray, y_closed: np.ndarray, unit: str) -> None:
+    """The open-loop signal, dashed grey, up to where it leaves :data:`OPEN_LOOP_SCALE` x the
+    closed loop's peak (marked, with the open loop's own peak named)."""
+    bound = OPEN_LOOP_SCALE * float(np.max(np.abs(y_closed), initial=0.0))
+    if not bound > 0:
+        return
+    out = np.flatnonzero(~(np.abs(y_open) <= bound))
+    n = out[0] if out.size else y_open.size
+    ax.plot(t[:n], y_open[:n], "--", color="0.45", lw=1.0, label="open loop")
+    if out.size:
+        yb = float(np.clip(y_open[n], -bound, bound))
+        ax.plot(t[n], yb, ">", color="0.45", ms=5)
+        finite = np.isfinite(y_open)
+        top = f"{np.max(np.abs(y_open[finite])):.3g} {unit}" if finite.all() else "non-finite"
+        ax.annotate(
+            f"open loop leaves the scale at {t[n]:.3g} s\n(reaches {top})",
+            (t[n], yb),
+            xytext=(8, -4 if yb > 0 else 4),
+            textcoords="offset points",
+            fontsize=7,
+            color="0.3",
+            va="top" if yb > 0 else "bottom",
+        )
 
 
 def windup_text(wound: dict) -> str:
@@ -80,8 +122,9 @@ class SimulationResult:
         known = list(self.outputs) + list(self.applied) + list(self.disturbance)
         raise InputError(f"signal {name!r}: not recorded; known: {known}")
 
+    @property
     def saturated_fraction(self) -> dict:
-        """Share of samples at which each control sat on its magnitude limit."""
+        """Share of samples at which each control sat on its magnitude limit [-]."""
         mag, _ = self.limits.arrays(list(self.applied))
         return {
             c: float(np.mean(np.abs(u) >= mag[i] * (1 - 1e-12)))
@@ -104,6 +147,7 @@ class SimulationResult:
                 }
         return out
 
+    @property
     def rate_limited_fraction(self) -> dict:
         """Share of samples at which each control moved at its rate limit (the command was
         rate-limited; the first sample starts from zero)."""
@@ -117,18 +161,32 @@ class SimulationResult:
         return out
 
     def plot(
-        self, tip: str | None = None, control: str | None = None, deflection: str | None = None
+        self,
+        tip: str | None = None,
+        control: str | None = None,
+        deflection: str | None = None,
+        open_loop: SimulationResult | None = None,
     ):
         """Gust (if any), tip response, control input with its limits and commanded values,
         and surface deflection, against time (matplotlib Figure).
+
+        Each axis is scaled to its signal. A magnitude limit is drawn (dotted red) when it is
+        within :data:`LIMIT_SHOWN` x the signal's peak, else named in the panel ("off scale");
+        a rate limit is named with the share of samples that reached it. Angles are drawn in
+        degrees (the result and its files keep radians). With ``open_loop`` (the same plant,
+        initial state and disturbance with the controller off), its outputs are drawn dashed
+        grey up to where they leave :data:`OPEN_LOOP_SCALE` x the closed loop's peak (a
+        diverging open loop), the point where they leave the scale marked and named.
 
         Parameters
         ----------
         tip, control, deflection : str, optional
             Signals to show (defaults: ``tip_disp`` or the first ``tip_*`` output, the first
             control, the first ``*_deflection`` output).
+        open_loop : SimulationResult, optional
+            Open-loop run to overlay.
         """
-        from matplotlib.figure import Figure
+        from .._figures import new_figure
 
         tip = tip or next(
             (n for n in ("tip_disp", *self.outputs) if n in self.outputs and n.startswith("tip")),
@@ -140,28 +198,60 @@ class SimulationResult:
         )
         panels = [g for g in self.disturbance if np.any(self.disturbance[g])] + [tip, control]
         panels += [deflection] if deflection else []
-        fig = Figure(layout="constrained", figsize=(7.5, 2.1 * len(panels)))
+        fig = new_figure(figsize=(7.5, 2.1 * len(panels)))
         axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
         for ax, name in zip(axes, panels, strict=True):
-            unit = self.units.get(name, "")
+            recorded = self.units.get(name) or ("rad" if name == deflection else "")
+            k, unit = _display_unit(recorded)
             if name == control:
-                ax.plot(self.t, self.applied[name], label="applied")
-                ax.plot(self.t, self.commands[name], "--", lw=0.8, label="commanded")
-                mag = self.limits.magnitude.get(name)
-                if mag is not None:
-                    for sgn in (-1, 1):
-                        ax.axhline(sgn * mag, color="r", lw=0.8, ls=":")
-                ax.legend(fontsize=8)
-            elif name == deflection:
-                ax.plot(self.t, np.degrees(self.outputs[name]))
-                unit = "deg"
+                self._control_panel(ax, name, k, unit)
             elif name in self.disturbance:
                 ax.plot(self.t, self.disturbance[name], color="0.4")
                 unit = unit or "m/s"
             else:
-                ax.plot(self.t, self.outputs[name])
+                ax.plot(self.t, k * self.outputs[name], label="closed loop")
+                if open_loop is not None and name in open_loop.outputs:
+                    y_open, y_closed = k * open_loop.outputs[name], k * self.outputs[name]
+                    _overlay(ax, open_loop.t, y_open, y_closed, unit)
+                    ax.legend(fontsize=8, loc="upper right")
             ax.set_ylabel(f"{name} [{unit}]")
             ax.grid(True, alpha=0.3)
         axes[-1].set_xlabel("time [s]")
-        fig.suptitle(f"closed loop at {self.speed:.4g} m/s")
+        off = not any(np.any(c) for c in self.commands.values())  # e.g. an open-loop run
+        fig.suptitle(
+            f"{'open loop (no command)' if off else 'closed loop'} at {self.speed:.4g} m/s"
+            + ("" if open_loop is None else " (open loop dashed grey)")
+        )
         return fig
+
+    def _control_panel(self, ax, name: str, k: float, unit: str) -> None:
+        """Applied and commanded input, the axis scaled to the applied input; the limits drawn
+        when near it, else named (see :meth:`plot`)."""
+        applied, command = k * self.applied[name], k * self.commands[name]
+        ax.plot(self.t, applied, label="applied")
+        ax.plot(self.t, command, "--", lw=0.8, label="commanded")
+        peak = float(np.max(np.abs(applied), initial=0.0))
+        mag = self.limits.magnitude.get(name)
+        notes = []
+        top = peak
+        if mag is not None and k * mag <= LIMIT_SHOWN * peak:
+            for sgn in (-1, 1):
+                ax.axhline(sgn * k * mag, color="r", lw=0.8, ls=":")
+            ax.plot([], [], color="r", lw=0.8, ls=":", label=f"limit \u00b1{k * mag:.4g} {unit}")
+            top = max(top, k * mag)
+        elif mag is not None:
+            notes.append(f"limit \u00b1{k * mag:.4g} {unit}, off scale")
+        top = top * 1.1 if top > 0 else 1.0
+        ax.set_ylim(-top, top)
+        wild = float(np.max(np.abs(command), initial=0.0))
+        if wild > top:
+            notes.append(f"commanded up to {wild:.3g} {unit}, off scale")
+        rate = self.limits.rate.get(name)
+        if rate is not None:
+            share = self.rate_limited_fraction.get(name, 0.0)
+            notes.append(
+                f"rate limit \u00b1{k * rate:.3g} {unit}/s, reached at {share:.1%} of samples"
+            )
+        for note in notes:  # legend lines: the legend keeps clear of the curves
+            ax.plot([], [], " ", label=note)
+        ax.legend(fontsize=7, loc="best")

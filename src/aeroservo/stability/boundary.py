@@ -37,6 +37,7 @@ from .certificate import DENSE_LIMIT, Certificate, certify, checked_basis
 from .crossings import VerificationError, Verifier, branch_crossings, sign_changes
 from .divergence import divergence_speeds
 from .modal import MIN_MODES, ModalBasis, ModalSystem, modal_basis, modal_info, modal_system
+from .near_critical import near_critical
 from .result import Crossing, FlutterResult
 from .tracking import EigenTracker
 
@@ -203,6 +204,7 @@ def flutter_boundary(
     crossings = [c for c in crossings if c.speed <= top]
     if exact_branches:
         _verify_all(ver)
+    near = near_critical(ver, rtol, top, band_top)
     crossings += _divergence(br, v_div, top)
     crossings.sort(key=lambda c: c.speed)
     lam = ver.best()
@@ -241,6 +243,7 @@ def flutter_boundary(
         mach=mach,
         compressibility="prandtl-glauert" if mach > 0 else None,
         damping=_damping_text(src),
+        near_critical=near,
     )
 
 

@@ -20,7 +20,12 @@ import numpy as np
 
 from ..aero.atmosphere import Atmosphere
 from ..errors import InputError
-from ..system.first_order import MACH_APPROXIMATE, MACH_LIMIT, compressibility_factors
+from ..system.first_order import (
+    MACH_APPROXIMATE,
+    MACH_LIMIT,
+    compressibility_factors,
+    mach_note,
+)
 from .brent import brentq
 from .divergence import divergence_speeds, static_speeds
 from .result import Crossing, FlutterResult
@@ -90,11 +95,9 @@ def flutter_at(
     if comp is None:
         r = _flight(solver(model, rho, **kw), atmosphere, None, [])
         for what, v in (("flutter", r.flutter_speed), ("divergence", r.divergence_speed)):
-            if v is not None and v / a > MACH_APPROXIMATE:
-                r.warnings.append(
-                    f"{what} at Mach {v / a:.3f} with incompressible aerodynamics: use the "
-                    f"Prandtl-Glauert correction (compressibility), valid to Mach {MACH_LIMIT:g}"
-                )
+            note = None if v is None else mach_note(what, v, a)
+            if note:
+                r.warnings.append(note)
         return r
 
     history: list[dict] = []

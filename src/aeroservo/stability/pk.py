@@ -30,6 +30,7 @@ from .boundary import default_v_max
 from .brent import brentq
 from .divergence import static_speeds
 from .modal import modal_basis
+from .near_critical import method_discrepancy
 from .pk_branches import restart, track
 from .result import Crossing, FlutterResult
 from .tracking import mac
@@ -276,7 +277,7 @@ def pk_flutter(
     crossings.sort(key=lambda c: c.speed)
     labeller = getattr(model, "label_modes", None)
     labels = labeller(basis @ phi) if labeller else [f"mode {j + 1}" for j in range(n_modes)]
-    return FlutterResult(
+    result = FlutterResult(
         speeds=speeds,
         eigenvalues=P,
         mode_labels=list(labels),
@@ -297,6 +298,13 @@ def pk_flutter(
         compressibility="prandtl-glauert" if mach > 0 else None,
         damping=getattr(getattr(model, "damping", None), "describe", lambda: "none")(),
     )
+    if boundary is not None:
+        b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
+        wagner = getattr(getattr(model, "wagner", None), "name", "")
+        note = method_discrepancy(boundary, result, b_ref, wagner)
+        if note:
+            result.warnings.append(note)
+    return result
 
 
 def _restarts(pk: _PK, boundary, crossings: list, P: np.ndarray, speeds: np.ndarray, rtol: float):

@@ -80,6 +80,10 @@ class FlutterResult:
         ``"prandtl-glauert"`` or None.
     damping : str
         Structural damping of the model (e.g. ``"g = 0.03"``, ``"none"``).
+    near_critical : list of NearCritical
+        Branches whose damping ratio has a local minimum just above zero (below
+        :data:`aeroservo.stability.near_critical.NEAR_ZETA`): not flutter by this model, but
+        close to it (:mod:`aeroservo.stability.near_critical`).
     info : dict
         Method details (modal model, certificate, counts), JSON-ready.
     """
@@ -101,6 +105,7 @@ class FlutterResult:
     mach: float = 0.0
     compressibility: str | None = None
     damping: str = "none"
+    near_critical: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if self.searched_up_to is None:
@@ -215,6 +220,17 @@ class FlutterResult:
                 }
                 for c in self.crossings
             ],
+            "near_critical": [
+                {
+                    "speed": n.speed,
+                    "speed_range": list(n.speed_range),
+                    "frequency": n.frequency,
+                    "damping_ratio": n.damping_ratio,
+                    "threshold": n.threshold,
+                    "mode": self.mode_labels[n.mode],
+                }
+                for n in self.near_critical
+            ],
             "modes": [
                 {"label": lab, "frequency_at_rest": float(self.frequencies[0, j])}
                 for j, lab in enumerate(self.mode_labels)
@@ -283,13 +299,22 @@ class FlutterResult:
                 f"  {c.kind:<10s} {c.speed * scale:10.6g} {unit}  {c.frequency:8.5g} Hz  "
                 f"{self.mode_labels[c.mode]}"
             )
+        for n in self.near_critical:
+            lo, hi = n.speed_range
+            lines.append(
+                f"  near-critical {lo * scale:.5g} .. {hi * scale:.5g} {unit}  "
+                f"{n.frequency:8.5g} Hz  {self.mode_labels[n.mode]}: damping ratio down to "
+                f"{n.damping_ratio:.2g} at {n.speed * scale:.5g} {unit} (stable, but within "
+                f"{n.threshold:g} of flutter)"
+            )
         modal = self.info.get("modal_model", {})
         if modal.get("enlarged"):
             steps = modal["enlarged"]
+            band = modal.get("cutoff_hz")
+            band = "every mode" if band is None else f"band up to {band:.4g} Hz"
             lines.append(
                 f"modal model enlarged from {steps[0]['modes'][0]} to {modal['n_modes']} modes "
-                f"(band up to {modal['cutoff_hz']:.4g} Hz): "
-                + "; ".join(f"{e['by']}: {e['reason']}" for e in steps)
+                f"({band}): " + "; ".join(f"{e['by']}: {e['reason']}" for e in steps)
             )
         lines.append(
             f"{self.n_states} states; branches: "

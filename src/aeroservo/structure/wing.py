@@ -69,7 +69,13 @@ class Segment:
         check_quantity(f"{n}.inertia", self.inertia, "inertia_per_length")
         s_alpha = self.mass * self.x_alpha * self.semichord
         i_min = s_alpha**2 / self.mass
-        check_number(f"{n}.inertia", self.inertia, unit="kg m", lo=i_min, lo_open=True)
+        if not self.inertia > i_min:
+            raise InputError(
+                f"{n}.inertia = {self.inertia:g}: allowed range is ({i_min:g}, inf) [kg m], "
+                "above m (x_alpha b)^2, the inertia of the static unbalance alone (mass "
+                f"{self.mass:g} kg/m, x_alpha {self.x_alpha:g}, semichord {self.semichord:g} m); "
+                + (_unit_hint(self.semichord, self.end - self.start) or "check them")
+            )
         check_quantity(f"{n}.EI", self.EI, "stiffness")
         check_quantity(f"{n}.GJ", self.GJ, "stiffness")
 
@@ -237,6 +243,17 @@ class Wing:
                     _check_flap_section(seg, cs)
         for seg in self.segments:
             _check_frequencies(seg, span)
+        chord = max(seg.semichord for seg in self.segments) * 2
+        if chord > span:
+            import warnings
+
+            warnings.warn(
+                f"wing '{self.name}': chord {chord:g} m longer than the span {span:g} m (aspect "
+                "ratio below 1: strip theory does not apply); "
+                + (_unit_hint(chord / 2, span) or "check the semichords"),
+                UserWarning,
+                stacklevel=3,
+            )
 
     def segment_at(self, x: float) -> Segment:
         """Segment containing station ``x`` [m] (the inboard one at a boundary)."""
@@ -320,3 +337,13 @@ def _check_flap_section(seg: Segment, cs: ControlSurface) -> None:
             f"inertia {seg.inertia:g} kg m): the section mass matrix is not positive definite; "
             "the section properties must include the flap"
         )
+
+
+def _unit_hint(semichord: float, length: float) -> str:
+    """A hint when a semichord [m] looks like millimetres ("" otherwise)."""
+    if semichord > max(length, 5.0):
+        return (
+            f"the semichord {semichord:g} m is longer than {length:g} m: if it is in "
+            f"millimetres, write {semichord / 1000:g}"
+        )
+    return ""

@@ -42,6 +42,8 @@ class Optimization:
     iterations: list = field(default_factory=list)
     n_boundaries: int = 0
     start: dict = field(default_factory=dict)
+    history: list = field(default_factory=list)
+    """One record per SLSQP iterate, the start first (:func:`optimize_wing`)."""
 
     def to_dict(self) -> dict:
         return {
@@ -117,6 +119,12 @@ def optimize_wing(
     Returns
     -------
     Optimization
+        ``iterations`` logs every design analysed (line searches included); ``history`` has
+        one record per SLSQP iterate, the start first: ``iteration``, ``variables``,
+        ``objective`` (the weighted sum, or the flutter speed [m/s]), ``flutter_speed`` and
+        ``divergence_speed`` [m/s] (None: none up to ``v_max``), ``constraints`` (each
+        constraint's ``speed / bound - 1``, >= 0 where it holds), ``designs_analysed`` and
+        ``n_boundaries`` (cumulative).
     """
     from scipy.optimize import minimize
 
@@ -131,12 +139,17 @@ def optimize_wing(
     cache: dict = {}
     log: list = []
     count = [0]
+    logged: dict = {}  # cache key -> (its entry of log, designs and boundaries so far)
+    iterates: list = []  # (x, designs analysed, boundaries) after each iteration
 
     def make(w):
         return AeroelasticModel(w, n_elements, wagner, damping=damping)
 
+    def key_of(x: np.ndarray) -> tuple:
+        return tuple(np.round(x, 14))
+
     def analyse(x: np.ndarray):
-        key = tuple(np.round(x, 14))
+        key = key_of(x)
         if key not in cache:
             p = x * scale
             how = gradients
@@ -164,6 +177,7 @@ def optimize_wing(
                     "gradients": how,
                 }
             )
+            logged[key] = (log[-1], len(log), count[0])
         return cache[key]
 
     # the objective's scale: its magnitude at the start (never its sign: a negative weight or
@@ -189,6 +203,12 @@ def optimize_wing(
                 "jac": lambda x, i=idx, b=bound: analyse(x)[i + 2] / b,
             }
         )
+
+    def iterate(x: np.ndarray) -> None:
+        if not iterates or key_of(iterates[-1][0]) != key_of(x):
+            iterates.append((np.array(x, dtype=float), len(log), count[0]))
+
+    iterate(p0 / scale)
     sol = minimize(
         f,
         p0 / scale,
@@ -197,7 +217,9 @@ def optimize_wing(
         constraints=cons,
         method="SLSQP",
         options={"maxiter": max_iterations, "ftol": 1e-9},
+        callback=iterate,
     )
+    iterate(sol.x)
     best = dict(zip(names, map(float, sol.x * scale), strict=True))
     check = flutter_boundary(
         make(with_parameters(wing, best)), density, v_max=v_max
@@ -220,6 +242,18 @@ def optimize_wing(
     objective_value = (
         check.flutter_speed if weights is None else float(weights @ np.array(list(best.values())))
     )
+
+    def speeds_at(x: np.ndarray) -> tuple:
+        """Flutter and divergence speed of an iterate, designs and boundaries analysed then."""
+        if key_of(x) not in logged:  # never analysed by SLSQP (no speed in the problem)
+            moved = with_parameters(wing, dict(zip(names, x * scale, strict=True)))
+            r = flutter_boundary(make(moved), density, v_max=v_max)  # a fresh look
+            return r.flutter_speed, r.divergence_speed, 0, 0
+        entry, n_designs, n_boundaries = logged[key_of(x)]
+        return entry["flutter_speed"], entry["divergence_speed"], n_designs, n_boundaries
+
+    top = v_max if v_max is not None else np.inf
+    history = _history(iterates, speeds_at, names, scale, weights, limits, top)
     return Optimization(
         variables=best,
         objective=objective_value,
@@ -232,7 +266,35 @@ def optimize_wing(
         iterations=log,
         n_boundaries=count[0] + 1,
         start=dict(zip(names, map(float, p0), strict=True)),
+        history=history,
     )
+
+
+def _history(iterates, speeds_at, names, scale, weights, limits, top) -> list:
+    """The records of :attr:`Optimization.history`, one per iterate ``(x, designs, boundaries)``
+    (``speeds_at(x)``: flutter and divergence speed [m/s] or None and the designs and
+    boundaries analysed by then; ``top``: a missing speed's value in the constraints, as the
+    optimizer saw it)."""
+    out = []
+    for k, (x, designs, boundaries) in enumerate(iterates):
+        p = x * scale
+        vf, vd, n_designs, n_boundaries = speeds_at(x)
+        speeds = {"flutter_speed": vf, "divergence_speed": vd}
+        out.append(
+            {
+                "iteration": k,
+                "variables": dict(zip(names, map(float, p), strict=True)),
+                "objective": vf if weights is None else float(weights @ p),
+                **speeds,
+                "constraints": {
+                    c: (speeds[c.replace("_min", "")] or top) / bound - 1.0
+                    for c, (_i, bound) in limits.items()
+                },
+                "designs_analysed": max(designs, n_designs),
+                "n_boundaries": max(boundaries, n_boundaries),
+            }
+        )
+    return out
 
 
 def design_variables(variables: object, start: dict, owner: str) -> tuple:

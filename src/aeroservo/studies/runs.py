@@ -37,6 +37,9 @@ class Run:
         Open-loop boundary (flutter scenarios; the plant's, for simulations).
     simulation : SimulationResult or None
         Time histories (simulate scenarios).
+    open_loop : SimulationResult or None
+        The same run with the controller off (same speed, initial state and gust), for the
+        time-history figure's overlay (controlled simulations with plots).
     boundary : ClosedLoopBoundary or None
         Closed-loop boundary, when the scenario asks for it.
     margins : LoopMargins or None
@@ -57,6 +60,7 @@ class Run:
     summary: dict
     flutter: object = None
     simulation: object = None
+    open_loop: object = None
     boundary: object = None
     margins: object = None
     margin_sweep: object = None
@@ -149,6 +153,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         summary (speeds [m/s], peaks and RMS in the signals' units, growth ratio of the
         response, closed-loop flutter speed if asked).
     """
+    from ..design.plant import OpenLoop
     from ..simulate.march import simulate
     from ..stability.boundary import flutter_boundary
 
@@ -188,6 +193,15 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         sensor_noise=noise,
         seed=scenario.seed,
     )
+    open_loop = None
+    if scenario.plots and not isinstance(controller, OpenLoop):  # overlay of the figure
+        open_loop = simulate(
+            plant,
+            OpenLoop(tuple(loop.controls), 1.0 / scenario.sample_rate),
+            duration=scenario.duration,
+            x0=x0,
+            disturbance=dist.gust,
+        )
     summary: dict = {
         "scenario": scenario.name,
         "kind": "simulate",
@@ -204,8 +218,8 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         "sample_rate": scenario.sample_rate,
         "n_plant_states": plant.nstates,
         "signals": {},
-        "saturated_fraction": result.saturated_fraction(),
-        "rate_limited_fraction": result.rate_limited_fraction(),
+        "saturated_fraction": result.saturated_fraction,
+        "rate_limited_fraction": result.rate_limited_fraction,
         "units": dict(result.units),
     }
     for group in (result.outputs, result.applied):
@@ -253,6 +267,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         summary,
         flutter=fr,
         simulation=result,
+        open_loop=open_loop,
         boundary=analysis.boundary,
         margins=analysis.margins,
         margin_sweep=analysis.sweep,
@@ -332,12 +347,12 @@ def run_scenario(
         "elapsed": res.elapsed,
         "cases_per_second": (res.n_cases - res.n_skipped) / max(res.elapsed, 1e-9),
     }
-    ok = res.table[res.table["status"] == "ok"]
-    if len(ok):
-        best = ok.loc[ok["suppression_margin"].idxmax()]
+    best = res.best_case()  # the case the figures outline (trade.ranking)
+    if best is not None:
         summary["best_case"] = {
             k: (v.item() if hasattr(v, "item") else v) for k, v in best.items() if v == v
         }
+        summary["best_case_criterion"] = res.best_criterion
     return Run(scenario, summary, trade=res, folder=folder)
 
 

@@ -35,6 +35,13 @@ __all__ = [
 
 KINDS = ("none", "modal", "rayleigh", "structural_g")
 
+PLAUSIBLE_G = 0.2
+"""Largest structural damping g [-] taken without a warning (g = 0.2 is zeta = 0.1; built
+wings have g of 0.01 to 0.06): a larger value is most likely a percentage."""
+
+PLAUSIBLE_RATIO = 0.1
+"""Largest modal damping ratio zeta [-] taken without a warning (see :data:`PLAUSIBLE_G`)."""
+
 
 @dataclass(frozen=True)
 class StructuralDamping:
@@ -81,6 +88,29 @@ class StructuralDamping:
             check_quantity("damping.beta", self.beta, "rayleigh_beta")
         if self.kind == "structural_g":
             check_quantity("damping.g", self.g, "structural_g")
+        self._warn_if_percentage()
+
+    def _warn_if_percentage(self) -> None:
+        """Warn about a damping that reads like a percentage typed as a fraction."""
+        import warnings
+
+        if self.kind == "structural_g" and self.g > PLAUSIBLE_G:
+            warnings.warn(
+                f"damping.g = {self.g:g} means zeta = {self.g / 2:g} ({50 * self.g:g} % of "
+                f"critical) in every mode, far above the 0.01 to 0.06 of built wings; g is a "
+                f"fraction, not a percentage: for {self.g:g} % write g = {self.g / 100:g}",
+                UserWarning,
+                stacklevel=4,
+            )
+        big = [z for z in self.ratios if z > PLAUSIBLE_RATIO] if self.kind == "modal" else []
+        if big:
+            warnings.warn(
+                f"damping.ratio = {big[0]:g} is {100 * big[0]:g} % of critical damping, far "
+                "above the 0.005 to 0.03 of built wings; the ratio is a fraction, not a "
+                f"percentage: for {big[0]:g} % write ratio = {big[0] / 100:g}",
+                UserWarning,
+                stacklevel=4,
+            )
 
     @classmethod
     def modal(cls, ratios: float | Sequence[float]) -> StructuralDamping:

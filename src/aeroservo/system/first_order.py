@@ -193,6 +193,32 @@ MACH_APPROXIMATE = 0.7
 """Above this Mach number results with the correction are flagged as approximate."""
 
 
+def mach_note(what: str, speed: float, speed_of_sound: float, assumed: bool = False) -> str | None:
+    """The warning for a speed [m/s] whose Mach number exceeds :data:`MACH_APPROXIMATE` with
+    incompressible aerodynamics, or None.
+
+    Parameters
+    ----------
+    what : str
+        What is at that speed (``"flutter"``, ``"the model"``).
+    speed, speed_of_sound : float
+        [m/s].
+    assumed : bool
+        Whether the speed of sound is the standard atmosphere's at the density (no altitude
+        given).
+    """
+    m = speed / speed_of_sound
+    if m <= MACH_APPROXIMATE:
+        return None
+    where = f" (speed of sound {speed_of_sound:.4g} m/s, standard atmosphere at this density)"
+    text = f"{what} at Mach {m:.3f}{where if assumed else ''} with incompressible aerodynamics: "
+    if m >= MACH_LIMIT:
+        return text + "the strip theory does not apply in transonic or supersonic flow"
+    return text + (
+        f"use the Prandtl-Glauert correction (compressibility), valid to Mach {MACH_LIMIT:g}"
+    )
+
+
 def check_mach(mach: object, field: str = "mach") -> float:
     """Validate the Mach number of the compressibility correction, ``0 <= M < 0.9``."""
     m = check_number(field, mach, lo=0.0)

@@ -4,7 +4,9 @@
 * :mod:`.grid` - the grid of cases and their stable ids;
 * :mod:`.cases` - one case: variant wing, open and closed loop, gust (:func:`evaluate_case`);
 * :mod:`.cluster` - the Dask runner (:func:`run_trade`, :func:`local_cluster`);
+* :mod:`.workers` - the Dask cluster, reached and checked, and its failures;
 * :mod:`.results` - tables and datasets (:class:`TradeResult`, :func:`load_trade`);
+* :mod:`.ranking` - which case is best, and why;
 * :mod:`.plots` - heat maps and the Pareto front.
 """
 

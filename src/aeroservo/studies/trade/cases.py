@@ -258,6 +258,6 @@ def _closed_loop(
     a = np.asarray(sim.outputs["tip_accel"], dtype=float)
     rec["hinge_moment_peak"] = _num(np.max(np.abs(u)))
     rec["hinge_moment_rms"] = _num(np.sqrt(np.mean(u**2)))
-    rec["hinge_moment_saturation"] = _num(sim.saturated_fraction()[control])
+    rec["hinge_moment_saturation"] = _num(sim.saturated_fraction[control])
     rec["tip_accel_peak"] = _num(np.max(np.abs(a)))
     rec["tip_accel_rms"] = _num(np.sqrt(np.mean(a**2)))

@@ -1,14 +1,13 @@
 """Running a trade study on Dask: a local cluster or an existing one, finished cases skipped,
-each case written atomically as it arrives (see :mod:`aeroservo.studies.trade`)."""
+each case written atomically as it arrives (see :mod:`aeroservo.studies.trade`); the cluster
+itself, and its failures, in :mod:`.workers`."""
 
 from __future__ import annotations
 
 import contextlib
 import json
-import os
-import re
 import time
-from collections.abc import Iterator
+import warnings
 from pathlib import Path
 
 from ...atomic import atomic_write, atomic_write_text
@@ -17,91 +16,21 @@ from .cases import _blank, evaluate_case
 from .grid import _digest, study_settings, trade_cases
 from .results import TradeResult, _assemble
 from .study import FORMAT, TradeStudy
+from .workers import (
+    LostWorkers,
+    _worker_probe,  # noqa: F401 (tests import it from here)
+    check_address,
+    connect,
+    local_cluster,
+    quiet_distributed,
+)
 
 __all__ = ["local_cluster", "run_trade"]
-
-_ADDRESS_RE = re.compile(r"(tcp|tls)://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})")
-_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def _case_task(study: TradeStudy, params: dict) -> dict:
     """The work function shipped to the workers (module level: picklable by reference)."""
     return evaluate_case(study, params)
-
-
-def _worker_probe() -> dict:
-    """What a worker runs before the study: its aeroservo version and thread settings."""
-    from ..._version import __version__
-
-    return {
-        "aeroservo": __version__,
-        "pid": os.getpid(),
-        **{k: os.environ.get(k) for k in _THREAD_VARS},
-    }
-
-
-@contextlib.contextmanager
-def local_cluster(n_workers: int = 2, *, timeout: float = 60.0) -> Iterator[object]:
-    """A ``distributed.LocalCluster`` for trade studies (context manager).
-
-    Worker processes on the loopback interface, one thread each, no dashboard, with
-    ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` and ``MKL_NUM_THREADS`` = 1 set *before*
-    the worker processes start (BLAS reads them when NumPy is imported), so that N workers use
-    N cores instead of fighting over them.
-
-    Parameters
-    ----------
-    n_workers : int
-        Worker processes.
-    timeout : float
-        Time allowed for a worker to reach the scheduler [s].
-    """
-    import dask
-    from distributed import LocalCluster
-
-    n_workers = check_int("n_workers", n_workers, lo=1, hi=256)
-    timeout = check_number("timeout", timeout, unit="s", lo=0.0, lo_open=True)
-    one = {k: "1" for k in _THREAD_VARS}
-    saved = {k: os.environ.get(k) for k in _THREAD_VARS}
-    # Nanny reads "pre-spawn-environ" (overridden by os.environ) when it is created and sets
-    # it in the worker's environment before spawning; restore ours once the workers run.
-    os.environ.update(one)
-    try:
-        with dask.config.set(
-            {
-                "distributed.nanny.pre-spawn-environ": one,
-                "distributed.comm.timeouts.connect": f"{timeout}s",
-            }
-        ):
-            cluster = LocalCluster(
-                n_workers=n_workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                dashboard_address=None,
-                # no dashboard; its HTTP server (health checks) on a free loopback port
-                scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
-                env=one,
-                death_timeout=timeout,
-            )
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-    try:
-        yield cluster
-    finally:
-        cluster.close()
-
-
-def _check_address(scheduler: str) -> str:
-    if not isinstance(scheduler, str) or not _ADDRESS_RE.fullmatch(scheduler.strip()):
-        raise InputError(
-            f"scheduler = {scheduler!r}: expected a Dask scheduler address 'tcp://host:port'"
-        )
-    return scheduler.strip()
 
 
 def _read_case(path: Path, cid: str) -> dict | None:
@@ -144,6 +73,8 @@ def run_trade(
     n_workers: int = 2,
     progress: bool = True,
     timeout: float = 60.0,
+    connect_timeout: float = 5.0,
+    worker_timeout: float = 10.0,
 ) -> TradeResult:
     """Run a trade study on Dask, skipping the cases already finished in ``out_dir``.
 
@@ -161,28 +92,51 @@ def run_trade(
     progress : bool
         Show a tqdm progress bar over the cases as they finish.
     timeout : float
-        Time allowed to start or reach the cluster [s].
+        Time allowed for the local cluster's workers to start [s].
+    connect_timeout : float
+        Time allowed to reach the scheduler [s].
+    worker_timeout : float
+        Time allowed for the scheduler to have a worker [s].
 
     Returns
     -------
     TradeResult
 
+    Raises
+    ------
+    InputError
+        No scheduler answers at ``scheduler`` within ``connect_timeout``, or it has no worker
+        within ``worker_timeout`` (nothing is left in a new ``out_dir``).
+    KeyboardInterrupt
+        On an interrupt, with a message saying how many cases are written.
+
+    Warns
+    -----
+    UserWarning
+        A worker was lost while the study ran; Dask resubmits its cases to the other workers,
+        and the warning says how many.
+
     Notes
     -----
     Each case's file is written as soon as its result arrives, so an interrupted run loses only
     the cases in flight. A case whose evaluation failed is a finished case (recorded with its
-    message); a case lost to the cluster itself (e.g. a worker killed) is reported in the
-    table but not written, so that the next run tries it again.
+    message); a case lost to the cluster itself (e.g. killing a worker each time it runs it)
+    is reported in the table but not written, so that the next run tries it again.
     """
     t_start = time.perf_counter()
     if not isinstance(study, TradeStudy):
         raise InputError(f"study = {study!r}: expected a TradeStudy")
     if scheduler is not None:
-        scheduler = _check_address(scheduler)
+        scheduler = check_address(scheduler)
     n_workers = check_int("n_workers", n_workers, lo=1, hi=256)
     timeout = check_number("timeout", timeout, unit="s", lo=0.0, lo_open=True)
+    connect_timeout = check_number(
+        "connect_timeout", connect_timeout, unit="s", lo=0.0, lo_open=True
+    )
+    worker_timeout = check_number("worker_timeout", worker_timeout, unit="s", lo=0.0, lo_open=True)
     out = Path(out_dir)
     cases_dir = out / "cases"
+    made_out = not out.exists()
     fresh = not cases_dir.exists()  # a new study: on a failure before any case, leave nothing
     cases_dir.mkdir(parents=True, exist_ok=True)
 
@@ -200,12 +154,21 @@ def run_trade(
     if pending:
         try:
             done = _run_pending(
-                study, pending, cases_dir, scheduler, n_workers, progress, timeout, n_skipped
+                study,
+                pending,
+                cases_dir,
+                scheduler,
+                n_workers,
+                progress,
+                (timeout, connect_timeout, worker_timeout),
+                n_skipped,
             )
         except BaseException:
             if fresh and not any(cases_dir.iterdir()):  # e.g. no scheduler at that address
                 (out / "study.json").unlink(missing_ok=True)
                 cases_dir.rmdir()
+                if made_out and not any(out.iterdir()):
+                    out.rmdir()
             raise
         records.update(done)
 
@@ -230,68 +193,88 @@ def _run_pending(
     scheduler: str | None,
     n_workers: int,
     progress: bool,
-    timeout: float,
+    timeouts: tuple[float, float, float],
     n_skipped: int,
 ) -> dict[str, dict]:
-    from distributed import Client, as_completed
     from tqdm import tqdm
 
+    timeout, connect_timeout, worker_timeout = timeouts
     done: dict[str, dict] = {}
-    with contextlib.ExitStack() as stack:
+    with contextlib.ExitStack() as quiet, contextlib.ExitStack() as stack:
         if scheduler is None:
             cluster = stack.enter_context(local_cluster(n_workers, timeout=timeout))
             address = cluster.scheduler_address
         else:
             address = scheduler
-        try:
-            client = stack.enter_context(Client(address, timeout=f"{timeout}s"))
-        except (OSError, TimeoutError) as exc:
-            raise InputError(
-                f"scheduler = {address!r}: cannot connect within {timeout:g} s ({exc})"
-            ) from None
-        try:
-            probes = client.run(_worker_probe)
-        except Exception as exc:
-            raise RuntimeError(
-                f"the workers of {address} cannot run aeroservo.studies.trade "
-                f"({type(exc).__name__}: {exc}); install aeroservo on them"
-            ) from exc
-        here = _worker_probe()["aeroservo"]
-        other = {w: p["aeroservo"] for w, p in probes.items() if p["aeroservo"] != here}
-        if other:
-            raise RuntimeError(
-                f"the workers of {address} run other aeroservo versions {other} than this "
-                f"process ({here}); the case ids and results would not match"
-            )
-        [study_f] = client.scatter([study], broadcast=True)
-        futures = client.map(
-            _case_task,
-            [study_f] * len(pending),
-            [{k: v for k, v in c.items() if k != "case_id"} for c in pending],
-            key=[f"trade-{study.name}-{c['case_id']}" for c in pending],
-            pure=False,
-        )
-        ids = {f.key: c["case_id"] for f, c in zip(futures, pending, strict=True)}
-        params = {c["case_id"]: c for c in pending}
+        client = connect(stack, address, connect_timeout, worker_timeout)
+        keys = [f"trade-{study.name}-{c['case_id']}" for c in pending]
+        lost = LostWorkers(client, keys)
         bar = stack.enter_context(
             tqdm(total=len(pending), desc=study.name, unit="case", disable=not progress)
         )
-        if n_skipped:
-            bar.set_postfix(skipped=n_skipped)
         try:
-            for fut, res in as_completed(futures, with_results=True, raise_errors=False):
-                cid = ids[fut.key]
-                if fut.status == "finished" and isinstance(res, dict):
-                    _write_case(cases_dir, res)
-                else:  # lost to the cluster: reported, not written (retried next run)
-                    lost = _blank(params[cid])
-                    lost.update(
-                        case_id=cid, failed_stage="cluster", error=f"not evaluated: {res!r}"
-                    )
-                    res = lost
-                done[cid] = res
-                fut.release()
-                bar.update(1)
-        finally:
-            client.cancel([f for f in futures if not f.done()])
+            _gather(client, study, pending, keys, cases_dir, done, lost, bar, n_skipped)
+        except KeyboardInterrupt:
+            quiet_distributed(quiet)
+            files = (cases_dir / f"{c['case_id']}.json" for c in pending)
+            n_written = n_skipped + sum(f.exists() for f in files)
+            raise KeyboardInterrupt(
+                f"{n_written} of {n_skipped + len(pending)} cases written to {cases_dir}; "
+                "run the study again to resume"
+            ) from None
     return done
+
+
+def _gather(
+    client,
+    study: TradeStudy,
+    pending: list[dict],
+    keys: list[str],
+    cases_dir: Path,
+    done: dict[str, dict],
+    lost: LostWorkers,
+    bar,
+    n_skipped: int,
+) -> None:
+    """Submit the pending cases (task keys ``keys``) to ``client`` and write each as it
+    arrives, into ``done`` too; report the workers lost meanwhile."""
+    from distributed import as_completed
+
+    [study_f] = client.scatter([study], broadcast=True)
+    futures = client.map(
+        _case_task,
+        [study_f] * len(pending),
+        [{k: v for k, v in c.items() if k != "case_id"} for c in pending],
+        key=keys,
+        pure=False,
+    )
+    ids = {f.key: c["case_id"] for f, c in zip(futures, pending, strict=True)}
+    params = {c["case_id"]: c for c in pending}
+    if n_skipped:
+        bar.set_postfix(skipped=n_skipped)
+    try:
+        for fut, res in as_completed(futures, with_results=True, raise_errors=False):
+            cid = ids[fut.key]
+            if fut.status == "finished" and isinstance(res, dict):
+                _write_case(cases_dir, res)
+            else:  # lost to the cluster: reported, not written (retried next run)
+                failed = _blank(params[cid])
+                failed.update(case_id=cid, failed_stage="cluster", error=f"not evaluated: {res!r}")
+                res = failed
+            done[cid] = res
+            fut.release()
+            _report_lost(lost, bar, n_skipped)
+            bar.update(1)
+        _report_lost(lost, bar, n_skipped)
+    finally:
+        client.cancel([f for f in futures if not f.done()])
+
+
+def _report_lost(lost: LostWorkers, bar, n_skipped: int) -> None:
+    """A warning per worker lost since the last call, and their count on the progress bar."""
+    notes = lost.notes()
+    for note in notes:
+        warnings.warn(note, UserWarning, stacklevel=5)
+    if notes:
+        post = {"skipped": n_skipped} if n_skipped else {}
+        bar.set_postfix(**post, lost_workers=lost.n_workers, resubmitted=lost.n_cases)

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
-from .plots import _heatmap, _pareto
+from .plots import HEATMAP_METRICS, _heatmap, _pareto
+from .ranking import BEST_CRITERION, best_index, is_closed_loop
 from .study import FORMAT, METRICS, PARAMETERS
 
 __all__ = ["TradeResult", "load_trade"]
@@ -68,39 +69,99 @@ class TradeResult:
             f"{self.n_skipped} skipped, {self.elapsed:.1f} s)"
         )
 
+    @property
+    def closed_loop(self) -> bool:
+        """Whether the study designed controllers (False: open-loop flutter only)."""
+        return is_closed_loop(self.table, self.settings)
+
+    @property
+    def best_criterion(self) -> str:
+        """What :meth:`best_case` maximizes (:data:`~.ranking.BEST_CRITERION`)."""
+        return BEST_CRITERION[self.closed_loop]
+
+    def best_case(self):
+        """The best case (:attr:`best_criterion`), a row of :attr:`table`, or None.
+
+        Returns
+        -------
+        pandas.Series or None
+        """
+        i = best_index(self.table, self.closed_loop)
+        return None if i is None else self.table.iloc[i]
+
     def heatmap(
         self,
-        metric: str = "closed_loop_flutter_speed",
+        metric: str | None = None,
         x: str | None = None,
         y: str | None = None,
+        *,
+        small_multiples: bool = True,
         **fixed: float,
     ):
-        """Heat map of a metric over two parameters.
+        """Heat map of a metric over two parameters, the best case outlined.
 
         Parameters
         ----------
-        metric : str
-            A name of :data:`METRICS`.
+        metric : str, optional
+            A name of :data:`METRICS` (default: the suppression margin, or the open-loop
+            flutter speed of an open-loop study).
         x, y : str, optional
-            Swept parameters on the axes (default: the first two).
+            Swept parameters on the axes (default: the first two not fixed).
+        small_multiples : bool
+            Draw one panel per value of the other parameters when there are at most
+            :data:`~.plots.MAX_PANELS` panels (False: hold them at the best case).
         **fixed
             The other parameters' positions: an ``int`` is an index into the parameter's
-            values, a ``float`` a value (the nearest one); default: the first value.
+            values, a ``float`` a value (the nearest one). Parameters neither fixed nor on
+            the axes give the panels or are held at their values in the best case.
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        return _heatmap(self.dataset, self.parameters, metric, x, y, fixed)
+        metric = HEATMAP_METRICS[self.closed_loop][0] if metric is None else metric
+        return _heatmap(
+            self.table,
+            self.parameters,
+            metric,
+            x,
+            y,
+            fixed,
+            best=best_index(self.table, self.closed_loop),
+            criterion=self.best_criterion,
+            name=self.name,
+            small_multiples=small_multiples,
+        )
 
     def pareto(self):
-        """Suppression margin versus peak hinge moment, the Pareto front highlighted.
+        """Suppression margin versus peak hinge moment: the Pareto front highlighted and
+        labelled with its cases' parameter values, saturated cases and the best case marked.
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        return _pareto(self.table, self.name)
+        best = best_index(self.table, self.closed_loop)
+        return _pareto(self.table, self.name, list(self.parameters), best)
+
+    def figures(self) -> dict:
+        """The figures a run writes: ``{file name: figure}``.
+
+        ``heatmap_<metric>.png`` for each metric of :data:`~.plots.HEATMAP_METRICS` that has a
+        value (a study of two or more parameters) and ``pareto.png`` (a closed-loop study);
+        none when no case succeeded.
+        """
+        ok = self.table["status"] == "ok"
+        if not ok.any():
+            return {}
+        out = {}
+        if len(self.parameters) >= 2:
+            for m in HEATMAP_METRICS[self.closed_loop]:
+                if self.table.loc[ok, m].notna().any():
+                    out[f"heatmap_{m}.png"] = self.heatmap(m)
+        if self.closed_loop:
+            out["pareto.png"] = self.pareto()
+        return out
 
 
 def _assemble(name: str, parameters: dict, rows: list[dict], settings: dict):
