@@ -131,13 +131,17 @@ FLUTTER_MODULES = {
     "aeroservo._threads",
     "aeroservo._version",
     "aeroservo.errors",
-    *(f"aeroservo.aero{m}" for m in ("", ".atmosphere", ".indicial", ".theodorsen")),
+    *(
+        f"aeroservo.aero{m}"
+        for m in ("", ".atmosphere", ".indicial", ".swept_strip", ".theodorsen")
+    ),
     *(
         f"aeroservo.cli{m}"
         for m in (
             "",
             ".analysis",
             ".envelope",
+            ".importing",
             ".options",
             ".optimize",
             ".results",
@@ -145,7 +149,10 @@ FLUTTER_MODULES = {
             ".sensitivity",
         )
     ),
-    *(f"aeroservo.files{m}" for m in ("", ".toml_tables", ".user_files", ".wing_file")),
+    *(
+        f"aeroservo.files{m}"
+        for m in ("", ".mass_tables", ".toml_tables", ".user_files", ".wing_file")
+    ),
     *(
         f"aeroservo.stability{m}"
         for m in (
@@ -164,10 +171,22 @@ FLUTTER_MODULES = {
             ".tracking",
         )
     ),
-    *(f"aeroservo.structure{m}" for m in ("", ".beam_element", ".examples", ".mesh", ".wing")),
+    *(
+        f"aeroservo.structure{m}"
+        for m in ("", ".beam_element", ".examples", ".masses", ".mesh", ".wing")
+    ),
     *(
         f"aeroservo.system{m}"
-        for m in ("", ".aeroelastic", ".assembly", ".damping", ".first_order", ".matrices")
+        for m in (
+            "",
+            ".aeroelastic",
+            ".assembly",
+            ".damping",
+            ".first_order",
+            ".matrices",
+            ".point_masses",
+            ".swept_assembly",
+        )
     ),
 }
 HEAVY = (

@@ -5,7 +5,7 @@ Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical fa
 Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
 need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``),
 :mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``examples``) and :mod:`.results`
-(``plot``, ``export``).
+(``plot``, ``export``), :mod:`.importing` (``import nastran``).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from .._threads import blas_limited, blas_threads
 from ..errors import InputError
-from . import analysis, optimize, results, scenarios, sensitivity
+from . import analysis, importing, optimize, results, scenarios, sensitivity
 
 __all__ = ["main"]
 
@@ -51,6 +51,7 @@ def _parser() -> argparse.ArgumentParser:
     results.add_parsers(sub)
     sensitivity.add_parsers(sub)
     optimize.add_parsers(sub)
+    importing.add_parsers(sub)
     return p
 
 
@@ -149,6 +150,7 @@ def _run(args: argparse.Namespace) -> int:
         **results.HANDLERS,
         **sensitivity.HANDLERS,
         **optimize.HANDLERS,
+        **importing.HANDLERS,
     }
     try:
         if getattr(args, "json", False):

@@ -264,6 +264,7 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
             modes=cols,
             title=title,
             shares=shares,
+            masses={pm.name: pm.station for pm in model.wing.masses},
         )
         writers.append((args.plot, figure_writer(fig, args.plot, dpi=130)))
     if args.animate:

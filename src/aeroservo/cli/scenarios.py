@@ -47,6 +47,7 @@ def add_parsers(sub) -> None:
 
 def _cmd_examples(args: argparse.Namespace) -> int:
     from ..files.scenario_file import shipped_scenarios
+    from ..files.toml_tables import read_toml
     from ..structure.examples import BUILTIN_WINGS
 
     print("built-in wings:")
@@ -58,6 +59,18 @@ def _cmd_examples(args: argparse.Namespace) -> int:
         print(f"scenarios ({found[0][0].parent}):")
         for path, kind, title in found:
             print(f"  {path.name:32s} {kind:9s} {title}")
+        wings = []
+        for path in sorted(found[0][0].parent.glob("*.toml")):
+            try:
+                data = read_toml(path)
+            except InputError:
+                continue
+            if set(data) <= {"wing", "analysis", "damping"} and isinstance(data.get("wing"), dict):
+                wings.append((path.name, str(data["wing"].get("name", ""))))
+        if wings:
+            print("wing files (aeroservo flutter FILE, aes.load_model(FILE)):")
+            for name, title in wings:
+                print(f"  {name:32s} {title}")
     return 0
 
 
@@ -254,7 +267,14 @@ def _readable(s: dict) -> str:
         if b:
             from ..studies.trade.study import PARAMETERS
 
-            params = ", ".join(f"{k} = {b[k]:g}" for k in PARAMETERS if k in b)
+            params = ", ".join(f"{k} = {b[k]:g}" for k in b if k in PARAMETERS)
+            if b.get("design_speed") is None:  # an open-loop study
+                lines.append(
+                    f"  highest open-loop flutter speed {f(b['open_loop_flutter_speed'], ' m/s')}"
+                    f" ({params})"
+                )
+                b = None
+        if b:
             bound = "suppression_margin" not in b  # stable to the end of the search
             margin = (
                 b["closed_loop_v_max"] / b["open_loop_flutter_speed"] - 1.0

@@ -17,7 +17,8 @@ def add_parsers(sub) -> None:
         help="derivatives of the flutter and divergence speeds to every wing parameter",
         description="Analytic sensitivities (left and right eigenvectors at the crossing, matrix "
         "derivatives from the element integrals): dV_f/dp, df_f/dp and dV_d/dp for every "
-        "segment, control-surface and actuator parameter named as in the wing file, the "
+        "segment, control-surface, actuator and concentrated-mass parameter named as in the "
+        "wing file (masses[i].mass, station, offset, inertia, vertical_offset), the "
         "structural damping's own parameters, the density, and the altitude (with --altitude; "
         "at the matched Mach number with --compressibility), in SI units per unit of the "
         "parameter.",

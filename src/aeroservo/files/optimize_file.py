@@ -65,6 +65,13 @@ UNITS = {
         "hinge_stiffness": "N m/rad/m",
     },
     "actuator": {"stiffness": "N m/rad", "station": "m"},
+    "mass": {
+        "mass": "kg",
+        "station": "m",
+        "offset": "m",
+        "inertia": "kg m^2",
+        "vertical_offset": "m",
+    },
 }
 """Units of the design variables (wing-file keys by owner, ``docs/wing-file.md``)."""
 

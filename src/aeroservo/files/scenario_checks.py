@@ -16,12 +16,25 @@ from .toml_tables import Table
 __all__ = ["cross_check"]
 
 
+def _check_study(s: Scenario) -> None:
+    """Validate a trade scenario's study (parameters against the wing, ...)."""
+    from ..studies.runs import study_from_scenario
+
+    try:
+        study_from_scenario(s)
+    except InputError as exc:
+        raise InputError(f"{s.source}: trade: {exc}") from None
+
+
 def cross_check(s: Scenario, top: Table) -> None:
     """Checks that need the wing: signal names, stations, limits against the initial state."""
     from ..design.loop import check_spec_signals
     from ..linear.signals import input_names, resolve_outputs
 
     if s.kind == "flutter":
+        return
+    if s.kind == "trade" and not s.trade["closed_loop"]:  # no loop: the study's checks only
+        _check_study(s)
         return
     sg = top.table("signals")
     if not s.wing.control_surfaces:
@@ -61,12 +74,7 @@ def cross_check(s: Scenario, top: Table) -> None:
     except InputError as exc:
         raise InputError(f"{s.source}: {key} -> {exc}") from None
     if s.kind == "trade":
-        from ..studies.runs import study_from_scenario
-
-        try:
-            study_from_scenario(s)  # validates the study (parameters against the wing, ...)
-        except InputError as exc:
-            raise InputError(f"{s.source}: trade: {exc}") from None
+        _check_study(s)
         return
     for name in s.sensor_noise:
         if name not in s.sensors:

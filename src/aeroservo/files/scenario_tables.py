@@ -108,12 +108,18 @@ def flight(fl: Table, kw: dict) -> None:
 
 
 def trade_table(tbl: Table, base: Path) -> dict:
-    """Raw trade settings; validated against the wing by :mod:`aeroservo.studies.trade`."""
+    """Raw trade settings; validated against the wing by :mod:`aeroservo.studies.trade`.
+    ``closed_loop = false``: the open-loop flutter boundary of each case only (no controller);
+    ``masses[i].<key>`` parameters sweep the wing's concentrated masses."""
+    from ..studies.trade.mass_parameters import mass_parameter
     from ..studies.trade.study import PARAMETERS
 
+    closed_loop = tbl.boolean("closed_loop", True)
     tbl.check_keys(
-        ("controller", "parameters"),
+        ("parameters", *(("controller",) if closed_loop else ())),
         (
+            "closed_loop",
+            "controller",
             "speed_factor",
             "gust_length",
             "gust_amplitude",
@@ -123,17 +129,22 @@ def trade_table(tbl: Table, base: Path) -> dict:
             "workers",
         ),
     )
-    spec = controller(tbl, tbl.path("controller", base, required=True), "controller")
-    if spec.type not in ("lqr", "lqg"):
+    spec = None
+    if closed_loop or tbl.has("controller"):
+        spec = controller(tbl, tbl.path("controller", base, required=True), "controller")
+    if spec is not None and spec.type not in ("lqr", "lqg"):
         tbl.fail(
             "controller",
             tbl.data["controller"],
             f"a trade study needs a linear controller (lqr or lqg), this one is {spec.type!r}",
         )
-    pt = tbl.table("parameters").check_keys((), tuple(PARAMETERS))
+    masses = tuple(k for k in tbl.table("parameters").data if mass_parameter(k) is not None)
+    pt = tbl.table("parameters").check_keys((), (*PARAMETERS, *masses))
     params = {}
     for name in pt.data:
-        if name in PARAMETER_QUANTITIES:
+        if name in masses:  # wing-file units; the study checks them against the wing
+            values = pt.numbers(name)
+        elif name in PARAMETER_QUANTITIES:
             values = pt.numbers(name, quantity=PARAMETER_QUANTITIES[name])
         else:  # fractions of the span or of the chord: the study checks their ranges
             values = pt.numbers(name, lo=0.0, lo_open=True)
@@ -146,6 +157,7 @@ def trade_table(tbl: Table, base: Path) -> dict:
     if n_cases > 1_000_000:
         tbl.fail("parameters", tbl.data["parameters"], f"{n_cases} cases: the limit is 1 000 000")
     return {
+        "closed_loop": closed_loop,
         "controller": spec,
         "parameters": params,
         "speed_factor": tbl.number("speed_factor", 1.1, quantity="speed_factor"),

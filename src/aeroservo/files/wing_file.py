@@ -19,8 +19,9 @@ from ..aero.atmosphere import isa, isa_ft
 from ..aero.indicial import wagner_set
 from ..errors import MAX_ELEMENTS, InputError, check_int, check_number, check_quantity
 from ..stability.matched import COMPRESSIBILITY
-from ..structure.wing import Actuator, ControlSurface, Segment, Wing
+from ..structure.wing import Actuator, ControlSurface, Segment, Wing, check_sweep
 from ..system.damping import NO_DAMPING, StructuralDamping
+from .mass_tables import masses_from_list, masses_toml
 from .toml_tables import read_toml
 
 __all__ = [
@@ -33,6 +34,7 @@ __all__ = [
 ]
 
 SEGMENT_KEYS = ("start", "end", "semichord", "a", "mass", "x_alpha", "inertia", "EI", "GJ")
+SEGMENT_OPTIONAL = ("sweep", "sweep_deg")
 SURFACE_REQUIRED = ("name", "start", "end", "hinge", "static_moment", "inertia")
 SURFACE_OPTIONAL = ("GJ", "hinge_stiffness", "actuators")
 ACTUATOR_KEYS = ("station", "stiffness")
@@ -105,15 +107,16 @@ def _list_of_tables(where: str, value: object) -> list:
 
 def wing_from_dict(data: Mapping, where: str = "wing") -> Wing:
     """Build a :class:`Wing` from the ``[wing]`` table of a wing file."""
-    tbl = _check_keys(where, data, ("span", "segments"), ("name", "control_surfaces"))
+    tbl = _check_keys(where, data, ("span", "segments"), ("name", "control_surfaces", "masses"))
     name = tbl.get("name", "wing")
     if not isinstance(name, str):
         raise InputError(f"{where}.name = {name!r}: expected a string")
     segments = []
     for i, seg in enumerate(_list_of_tables(f"{where}.segments", tbl["segments"])):
         w = f"{where}.segments[{i}]"
-        _check_keys(w, seg, SEGMENT_KEYS)
+        _check_keys(w, seg, SEGMENT_KEYS, SEGMENT_OPTIONAL)
         vals = {k: check_number(f"{w}.{k}", seg[k]) for k in SEGMENT_KEYS}
+        vals["sweep"] = segment_sweep(w, seg)
         segments.append(Segment(**vals, name=w))
     surfaces = []
     for i, cs in enumerate(
@@ -141,7 +144,24 @@ def wing_from_dict(data: Mapping, where: str = "wing") -> Wing:
         }
         surfaces.append(ControlSurface(name=cs["name"], actuators=tuple(acts), **nums))
     span = check_number(f"{where}.span", tbl["span"], unit="m")
-    return Wing(span=span, segments=tuple(segments), control_surfaces=tuple(surfaces), name=name)
+    masses = masses_from_list(f"{where}.masses", tbl.get("masses", []))
+    return Wing(
+        span=span,
+        segments=tuple(segments),
+        control_surfaces=tuple(surfaces),
+        name=name,
+        masses=masses,
+    )
+
+
+def segment_sweep(where: str, seg: Mapping) -> float:
+    """The sweep angle [rad] of a segment table: ``sweep`` [rad] or ``sweep_deg`` [deg], 0 if
+    neither is given (one clear line when both are, or when it is beyond +-60 deg)."""
+    if "sweep" in seg and "sweep_deg" in seg:
+        raise InputError(f"{where}.sweep_deg = {seg['sweep_deg']!r}: give sweep [rad] or sweep_deg")
+    if "sweep_deg" in seg:
+        return check_sweep(f"{where}.sweep_deg", seg["sweep_deg"], degrees=True)
+    return check_sweep(f"{where}.sweep", seg.get("sweep", 0.0))
 
 
 def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOptions:
@@ -270,6 +290,8 @@ def wing_toml(wing: Wing) -> str:
     for seg in wing.segments:
         lines += ["", "[[wing.segments]]"]
         lines += [f"{k} = {num(getattr(seg, k))}" for k in SEGMENT_KEYS]
+        if seg.sweep != 0.0:
+            lines.append(f"sweep = {num(seg.sweep)}")
     for cs in wing.control_surfaces:
         lines += ["", "[[wing.control_surfaces]]", f"name = {json.dumps(cs.name)}"]
         keys = SURFACE_REQUIRED[1:] + ("GJ", "hinge_stiffness")
@@ -277,4 +299,5 @@ def wing_toml(wing: Wing) -> str:
         for act in cs.actuators:
             lines += ["", "[[wing.control_surfaces.actuators]]"]
             lines += [f"{k} = {num(getattr(act, k))}" for k in ACTUATOR_KEYS]
+    lines += masses_toml(wing.masses)
     return "\n".join(lines) + "\n"

@@ -35,6 +35,7 @@ import numpy as np
 from ..errors import InputError, check_number
 from ..errors import show_value as describe
 from ..structure.beam_element import point_shapes
+from ..system.swept_assembly import kink_transforms
 
 __all__ = [
     "Sensor",
@@ -308,7 +309,8 @@ def field_row(model, field: int, x: float, surface: int | None = None) -> np.nda
     """Row r with ``r @ q`` = field value at x (0 = w, 1 = phi, 2 = delta of ``surface``)."""
     e, xi = _element_on(model, x, surface if field == 2 else None)
     n, _ = point_shapes(model.mesh.lengths[e], xi)
-    return _scatter_row(model, e, n[field])
+    kinks = kink_transforms(model.wing, model.mesh)  # None unless the elastic axis is cranked
+    return _scatter_row(model, e, n[field] if kinks is None else n[field] @ kinks[e])
 
 
 def surface_at(model, x: float) -> int | None:

@@ -161,6 +161,7 @@ def plot_modes(
     modes: Sequence[int] | None = None,
     title: str | None = None,
     shares: dict | None = None,
+    masses: dict | None = None,
 ) -> Figure:
     """Panels of mode shapes along the span, one per mode (two for a complex mode).
 
@@ -187,6 +188,8 @@ def plot_modes(
     title : str, optional
     shares : dict, optional
         ``{field: (n_columns,) array}`` of strain-energy shares (:func:`strain_energy_shares`).
+    masses : dict, optional
+        Concentrated mass name -> station [m]: a dotted line and a marker at each.
     """
     surfaces = surfaces or {}
     cols = list(range(fields["w"].shape[1])) if modes is None else list(modes)
@@ -208,6 +211,7 @@ def plot_modes(
             lines = _real_panel(ax, x, col)
         ax.set_title(head, fontsize=9)
         ax.grid(True, alpha=0.3)
+        lines += _mass_marks(ax, masses or {})
         ax.legend(handles=lines, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1].set_xlabel("spanwise station x [m]")
     note = "each field divided by its own peak (in the legend)"
@@ -219,6 +223,21 @@ def plot_modes(
     return fig
 
 
+def _mass_marks(ax, masses: dict) -> list:
+    """A dotted line at each concentrated mass's station, a marker on the axis, one legend
+    entry for them all."""
+    from matplotlib.transforms import blended_transform_factory
+
+    if not masses:
+        return []
+    at_bottom = blended_transform_factory(ax.transData, ax.transAxes)
+    for station in masses.values():
+        ax.axvline(station, color="0.35", ls=":", lw=1.0)
+        ax.plot([station], [0.0], "v", color="0.2", ms=7, transform=at_bottom, clip_on=False)
+    names = ", ".join(f"{k} ({v:.3g} m)" for k, v in masses.items())
+    return ax.plot([], [], "v:", color="0.2", label=f"mass: {names}")
+
+
 def plot_mode_shapes(model, modes, *, n: int = 4) -> Figure:
     """The first ``n`` natural modes of a model (``modes``: :class:`NaturalModes`), with their
     strain-energy shares."""
@@ -226,8 +245,14 @@ def plot_mode_shapes(model, modes, *, n: int = 4) -> Figure:
     fields = model.mode_fields(modes.shapes[:, :n])
     surfaces = {cs.name: (cs.start, cs.end) for cs in model.wing.control_surfaces}
     shares = strain_energy_shares(model, modes.shapes[:, :n])
+    masses = {pm.name: pm.station for pm in model.wing.masses}
     return plot_modes(
-        fields, modes.labels[:n], modes.frequencies[:n], surfaces=surfaces, shares=shares
+        fields,
+        modes.labels[:n],
+        modes.frequencies[:n],
+        surfaces=surfaces,
+        shares=shares,
+        masses=masses,
     )
 
 

@@ -65,6 +65,9 @@ def parameter_values(wing) -> dict[str, tuple[str, tuple[int, ...], str, float]]
             for key in PARAMETERS["actuator"]:
                 name = f"control_surfaces[{k}].actuators[{j}].{key}"
                 out[name] = ("actuator", (k, j), key, float(getattr(act, key)))
+    for i, pm in enumerate(wing.masses):
+        for key in PARAMETERS["mass"]:
+            out[f"masses[{i}].{key}"] = ("mass", (i,), key, float(getattr(pm, key)))
     return out
 
 
@@ -157,7 +160,8 @@ def flutter_sensitivities(
         Air density [kg/m^3]; or give ``atmosphere``.
     parameters : list of str, optional
         Names as in the wing file (``"segments[0].GJ"``, ``"segments[0].a"``,
-        ``"control_surfaces[0].hinge"``, ``"control_surfaces[0].actuators[1].station"``), the
+        ``"control_surfaces[0].hinge"``, ``"control_surfaces[0].actuators[1].station"``,
+        ``"masses[0].mass"``, ``.station``, ``.offset``, ``.inertia``, ``.vertical_offset``), the
         damping's (``"damping.g"``, ``"damping.ratio"``, ``"damping.alpha"``), and the flight
         condition's (``"density"``; ``"altitude"`` with an atmosphere; ``"mach"`` at a fixed
         Mach number); default all of them.

@@ -18,7 +18,7 @@ import scipy.sparse.linalg as spla
 
 from ..aero.atmosphere import isa, isa_slopes, on_layer_boundary
 from ..system.damping import damping_derivatives
-from ..system.derivatives import matrix_derivative, station_on_node, zero_derivative
+from ..system.derivatives import matrix_derivative, station_kink, zero_derivative
 from ..system.first_order import pencil_blocks
 from ..system.pencil_forms import pencil_form, static_form
 
@@ -68,20 +68,22 @@ class Terms:
             return None
         owner, index, key, _ = entry
         sides = [1]
-        where = station_on_node(m.wing, m.mesh, *index) if key == "station" else None
+        where, inward, why = (
+            station_kink(m.wing, m.mesh, owner, index) if key == "station" else (None, 1, "")
+        )
         if where == "node":
             sides = [-1, 1]
-            why = "on a mesh node: the discretized model has a kink there"
             self.kinks[name] = (why, ("inboard", "outboard"))
-        elif where == "edge":  # the station may only move into its surface
-            cs = m.wing.control_surfaces[index[0]]
-            x = cs.actuators[index[1]].station
-            sides = [1 if abs(x - cs.start) < abs(x - cs.end) else -1]
-            why = "at an end of its control surface (a bound of the station): one-sided"
+        elif where == "edge":  # the station may only move inwards (into its surface, the span)
+            sides = [inward]
             self.kinks[name] = (why, ("inward",))
+        elif where == "jump":
+            return why
         mats = []
         for side in sides:
-            dam = matrix_derivative(m.wing, m.mesh, owner, index, key, side=side)
+            dam = matrix_derivative(
+                m.wing, m.mesh, owner, index, key, side=side, sweep_terms=m.sweep_terms
+            )
             if self.damping is not None:
                 try:
                     dam = replace(dam, Cs=self.damping[0](dam.Ms, dam.Ks))

@@ -6,13 +6,20 @@
   **Illustrative**: the aileron data of Mozaffari-Jovin et al. (2015), used by the seed paper,
   are not publicly available, so the aileron parameters below are aeroservo's own choice and
   its flutter speed is not comparable with the seed's 109.5 m/s.
+* :func:`goland_store` - the Goland wing with a 60 kg underwing store at 75 % span
+  (illustrative): a concentrated mass aft of the elastic axis that lowers the flutter speed.
+* :func:`goland_swept` - the Goland wing swept back 30 deg (modified strip theory,
+  ``docs/sweep.md``); illustrative: the section properties are Goland's, taken normal to the
+  swept elastic axis, and the span is measured along it.
 """
 
 from __future__ import annotations
 
-from .wing import Actuator, ControlSurface, Segment, Wing
+from dataclasses import replace
 
-__all__ = ["goland", "goland_aileron", "BUILTIN_WINGS"]
+from .wing import Actuator, ConcentratedMass, ControlSurface, Segment, Wing
+
+__all__ = ["goland", "goland_aileron", "goland_swept", "goland_store", "BUILTIN_WINGS"]
 
 GOLAND_SPAN = 6.096  # m (20 ft)
 GOLAND_SEMICHORD = 0.9144  # m (chord 6 ft)
@@ -103,5 +110,60 @@ def goland_aileron(
     )
 
 
-BUILTIN_WINGS = {"goland": goland, "goland_aileron": goland_aileron}
+def goland_swept(sweep: float = 0.5235987755982988) -> Wing:
+    """Goland wing swept back 30 deg (illustrative; sections normal to the elastic axis).
+
+    Goland's section properties and stiffnesses normal to the elastic axis, the 6.096 m span
+    measured along it, swept by ``sweep`` [rad] (+ backward, default pi/6 = 30 deg). Same as
+    ``scenarios/goland_swept.toml``.
+
+    Parameters
+    ----------
+    sweep : float
+        Sweep angle of the elastic axis [rad], within +-60 deg.
+    """
+    seg = replace(goland().segments[0], sweep=sweep, name="goland_swept")
+    return Wing(span=GOLAND_SPAN, segments=(seg,), name="Goland wing, swept (illustrative)")
+
+
+def goland_store(mass: float = 60.0, offset: float = 0.3) -> Wing:
+    """Goland wing carrying an underwing store at 75 % span (illustrative).
+
+    A pylon-mounted store (e.g. a fuel tank) of ``mass`` [kg] (default 60 kg, 28 % of the
+    wing's 218 kg) at 4.572 m, its CG ``offset`` [m] aft of the elastic axis (default 0.3 m, at
+    about 50 % chord) and 0.3 m below it, 5 kg m^2 of pitch inertia about its own CG. The aft
+    store lowers the flutter speed from 137.8 to 128.3 m/s at sea level (10 elements); moved
+    0.3 m ahead of the elastic axis it raises it to 196.4 m/s. Same as
+    ``scenarios/goland_store.toml``.
+
+    Parameters
+    ----------
+    mass : float
+        Store mass [kg].
+    offset : float
+        Chordwise position of the store's CG aft of the elastic axis [m].
+    """
+    store = ConcentratedMass(
+        station=0.75 * GOLAND_SPAN,
+        mass=mass,
+        offset=offset,
+        inertia=5.0,
+        vertical_offset=-0.3,
+        name="store",
+    )
+    base = goland()
+    return Wing(
+        span=base.span,
+        segments=base.segments,
+        name="Goland wing with store (illustrative)",
+        masses=(store,),
+    )
+
+
+BUILTIN_WINGS = {
+    "goland": goland,
+    "goland_aileron": goland_aileron,
+    "goland_swept": goland_swept,
+    "goland_store": goland_store,
+}
 """Wings available by name on the command line and in scenario files."""

@@ -17,8 +17,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import RANGES, InputError, check_number, check_quantity
+from .masses import ConcentratedMass, check_masses
 
-__all__ = ["Segment", "Actuator", "ControlSurface", "Wing"]
+__all__ = ["Segment", "Actuator", "ControlSurface", "Wing", "MAX_SWEEP", "ConcentratedMass"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,10 @@ class Segment:
         Flapwise bending stiffness [N m^2].
     GJ : float
         Torsional stiffness [N m^2].
+    sweep : float
+        Sweep angle of the elastic axis [rad], positive backward (aft), within
+        +-:data:`MAX_SWEEP`. Section properties and the strip are normal to the elastic axis
+        and ``start``/``end`` are measured along it (``docs/sweep.md``).
     """
 
     start: float
@@ -56,6 +61,7 @@ class Segment:
     EI: float
     GJ: float
     name: str = "segment"
+    sweep: float = 0.0
 
     def __post_init__(self) -> None:
         n = _name("segment", self.name)
@@ -78,6 +84,7 @@ class Segment:
             )
         check_quantity(f"{n}.EI", self.EI, "stiffness")
         check_quantity(f"{n}.GJ", self.GJ, "stiffness")
+        object.__setattr__(self, "sweep", check_sweep(f"{n}.sweep", self.sweep))
 
     @property
     def static_moment(self) -> float:
@@ -176,7 +183,7 @@ class ControlSurface:
 
 @dataclass(frozen=True)
 class Wing:
-    """A straight cantilever wing clamped at x = 0.
+    """A cantilever wing clamped at x = 0 (straight, or swept per segment: ``Segment.sweep``).
 
     Parameters
     ----------
@@ -188,12 +195,15 @@ class Wing:
         Non-overlapping trailing-edge surfaces inside [0, span].
     name : str
         Label used in reports.
+    masses : tuple of ConcentratedMass
+        Concentrated masses (stores, engines, balance weights), ``structure/masses.py``.
     """
 
     span: float
     segments: tuple[Segment, ...]
     control_surfaces: tuple[ControlSurface, ...] = field(default_factory=tuple)
     name: str = "wing"
+    masses: tuple[ConcentratedMass, ...] = field(default_factory=tuple)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -243,6 +253,8 @@ class Wing:
                     _check_flap_section(seg, cs)
         for seg in self.segments:
             _check_frequencies(seg, span)
+        object.__setattr__(self, "masses", _sequence("wing.masses", self.masses))
+        check_masses(self)
         chord = max(seg.semichord for seg in self.segments) * 2
         if chord > span:
             import warnings
@@ -272,8 +284,9 @@ class Wing:
 
     @property
     def mass(self) -> float:
-        """Total wing mass [kg]."""
-        return float(sum(s.mass * (s.end - s.start) for s in self.segments))
+        """Total wing mass [kg], concentrated masses included."""
+        distributed = sum(s.mass * (s.end - s.start) for s in self.segments)
+        return float(distributed + sum(pm.mass for pm in self.masses))
 
 
 def _name(kind: str, name: object) -> str:
@@ -289,6 +302,27 @@ def _sequence(field: str, value: object) -> tuple:
             f"{field} = {value!r}: expected a list or tuple (put a single item in a list)"
         )
     return tuple(value)
+
+
+MAX_SWEEP = float(np.deg2rad(60.0))
+"""Largest sweep angle of the elastic axis [rad] (60 deg), forward or backward."""
+
+
+def check_sweep(field: str, value: object, *, degrees: bool = False) -> float:
+    """Validate a sweep angle: a real number within +-:data:`MAX_SWEEP` (+-60 deg), refused with
+    the reason beyond it. Returns it in radians (``degrees``: given in degrees)."""
+    v = check_number(field, value, unit="deg" if degrees else "rad")
+    rad = float(np.deg2rad(v)) if degrees else v
+    if abs(rad) > MAX_SWEEP + 5e-5:  # 1.0472 (60 deg to 4 decimals) is accepted, then clipped
+        shown = f"{v:g} deg" if degrees else f"{v:g} rad ({np.rad2deg(v):.4g} deg)"
+        allowed = "[-60, 60] deg" if degrees else "[-1.0472, 1.0472] rad (+-60 deg)"
+        raise InputError(
+            f"{field} = {shown}: allowed range is {allowed}: the strip theory takes the flow "
+            "normal to the elastic axis, V cos(sweep), and the modified strip method is "
+            "validated only to about 60 deg (beyond it the spanwise flow dominates)"
+            + ("" if degrees else "; an angle in degrees is a unit error")
+        )
+    return float(np.clip(rad, -MAX_SWEEP, MAX_SWEEP))
 
 
 FREQUENCY_RANGE = (1e-3, 1e5)

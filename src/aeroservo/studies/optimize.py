@@ -64,10 +64,12 @@ class Optimization:
 def with_parameters(wing, values: dict):
     """The wing with parameters (wing-file names) set to ``values``."""
     table = parameter_values(wing)
-    segs, surfaces = list(wing.segments), list(wing.control_surfaces)
+    segs, surfaces, masses = list(wing.segments), list(wing.control_surfaces), list(wing.masses)
     for name, v in values.items():
         owner, idx, key, _ = table[name]
-        if owner == "segment":
+        if owner == "mass":
+            masses[idx[0]] = replace(masses[idx[0]], **{key: v})
+        elif owner == "segment":
             segs[idx[0]] = replace(segs[idx[0]], **{key: v})
         elif owner == "surface":
             surfaces[idx[0]] = replace(surfaces[idx[0]], **{key: v})
@@ -76,7 +78,9 @@ def with_parameters(wing, values: dict):
             acts = list(cs.actuators)
             acts[idx[1]] = replace(acts[idx[1]], **{key: v})
             surfaces[idx[0]] = replace(cs, actuators=tuple(acts))
-    return replace(wing, segments=tuple(segs), control_surfaces=tuple(surfaces))
+    return replace(
+        wing, segments=tuple(segs), control_surfaces=tuple(surfaces), masses=tuple(masses)
+    )
 
 
 def optimize_wing(

@@ -384,4 +384,5 @@ def study_from_scenario(scenario: Scenario):
         v_max_factor=t["v_max_factor"],
         n_grid=t["n_grid"],
         name=scenario.result,
+        closed_loop=t.get("closed_loop", True),
     )

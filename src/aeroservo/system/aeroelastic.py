@@ -8,6 +8,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..aero.indicial import IndicialSet, wagner_set
+from ..aero.swept_strip import check_sweep_terms
 from ..errors import MAX_ELEMENTS, InputError, check_int, check_number
 from ..structure.mesh import Mesh, build_mesh
 from ..structure.wing import Wing
@@ -52,6 +53,9 @@ class AeroelasticModel:
         ``"fit2"``, ``"fit3"``, ``"fit4"``, or ``{"A": [...], "b": [...]}``.
     damping : StructuralDamping, optional
         Structural damping (:mod:`aeroservo.system.damping`); default none.
+    sweep_terms : {"full", "classical"}
+        Spanwise-convection terms of swept segments: all of them (default), or the bending
+        slope's alone, as the classical divergence closed form (``docs/sweep.md``).
 
     Notes
     -----
@@ -66,6 +70,8 @@ class AeroelasticModel:
         n_elements: int = 10,
         wagner: object = "rt_jones",
         damping: StructuralDamping | None = None,
+        *,
+        sweep_terms: str = "full",
     ):
         if not isinstance(wing, Wing):
             raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
@@ -74,7 +80,8 @@ class AeroelasticModel:
         self.wagner: IndicialSet = wagner_set(wagner)
         self.damping = NO_DAMPING if damping is None else damping
         self.mesh: Mesh = build_mesh(wing, self.n_elements)
-        am = assemble(wing, self.mesh)
+        self.sweep_terms = check_sweep_terms(sweep_terms)
+        am = assemble(wing, self.mesh, sweep_terms=self.sweep_terms)
         self.matrices: AeroMatrices = replace(am, Cs=damping_matrix(self.damping, am.Ms, am.Ks))
         self.properties = element_properties(wing, self.mesh)
         self._systems: dict[tuple[float, float], FirstOrderSystem] = {}

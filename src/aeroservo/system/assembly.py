@@ -14,6 +14,8 @@ from ..structure.beam_element import field_shapes, gauss_rule, integrate, lag_sh
 from ..structure.mesh import Mesh
 from ..structure.wing import Wing
 from .matrices import AeroMatrices, StripGroup
+from .point_masses import point_mass_blocks
+from .swept_assembly import gradient_shapes, kink_transforms, strip_coefficients, to_nodal
 
 __all__ = ["assemble", "element_properties", "section_coefficients"]
 
@@ -91,7 +93,7 @@ def scatter_blocks(
     return mat.tocsr()
 
 
-def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
+def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatrices:
     """Build the structural and aerodynamic influence matrices of a wing.
 
     Parameters
@@ -99,6 +101,8 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     wing : Wing
     mesh : Mesh
         From :func:`aeroservo.structure.mesh.build_mesh`.
+    sweep_terms : {"full", "classical"}
+        Spanwise-convection terms of swept segments (``docs/sweep.md``).
 
     Returns
     -------
@@ -107,11 +111,14 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     p = element_properties(wing, mesh)
     L = mesh.lengths
     xi, wts = gauss_rule()
-    N, D, _ = field_shapes(L, xi)
+    N, D, S = field_shapes(L, xi)
     n_el = mesh.n_elements
     nz = lag_shapes(xi)[None, :, None, :].repeat(n_el, axis=0)  # (n_el, n_g, 1, 2)
 
     ms, kd, kn, aero = section_coefficients(p)
+    c = strip_coefficients(wing, mesh, aero, p["b"], sweep_terms)  # modified strips if swept
+    N1 = gradient_shapes(N, D, S)  # [w', phi', delta'], convected by a swept wing's spanwise flow
+    kinks = kink_transforms(wing, mesh)  # None unless the sweep changes between segments
 
     def elem(left, coef, right):
         return integrate(L, wts, left, coef[:, None], right)
@@ -126,6 +133,7 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
 
     def split(blocks, rows, cols, shape):
         """Scatter, then split extended structural rows/columns into free and root parts."""
+        blocks = to_nodal(blocks, kinks, rows is edofs, cols is edofs)  # a cranked axis
         full = scatter_blocks(blocks, rows, cols, shape)
         if cols is edofs:
             full = full[:, :n_q]
@@ -136,7 +144,8 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     def qq(coef, left=N, right=N):
         return split(elem(left, coef, right), edofs, edofs, (n_x, n_x))
 
-    Ms, Ms_r = qq(ms)
+    m_blocks = elem(N, ms, N) + point_mass_blocks(wing, mesh)  # + 0.0 without masses
+    Ms, Ms_r = split(m_blocks, edofs, edofs, (n_x, n_x))
     parts, parts_r = {}, {}
     for i, name in enumerate(("bending", "torsion")):
         parts[name], parts_r[name] = qq(kd * _unit(i), D, D)
@@ -154,26 +163,30 @@ def assemble(wing: Wing, mesh: Mesh) -> AeroMatrices:
     # circulatory matrices and load vectors grouped by semichord (exact C(k), gusts)
     groups, groups_r = [], []
     ones_z = np.ones((n_el, 1, 1))
-    for b in np.unique(p["b"]):
-        sel = (p["b"] == b).astype(float)[:, None, None]
-        pq, pq_r = qq(aero.Pq * sel)
-        pd, pd_r = qq(aero.Pd * sel)
-        gw = scatter_blocks(elem(N, aero.w[:, :, None] * sel, nz), edofs, lag_dofs, (n_x, n_n))
+    for b in np.unique(c["b"]):  # the semichord of the reduced frequency (b / cos(sweep))
+        sel = (c["b"] == b).astype(float)[:, None, None]
+        pq, pq_r = qq(c["Pq"] * sel)
+        if c["Pg"] is not None:
+            pg, pg_r = qq(c["Pg"] * sel, N, N1)
+            pq, pq_r = pq + pg, pq_r + pg_r
+        pd, pd_r = qq(c["Pd"] * sel)
+        gw = to_nodal(elem(N, c["w"][:, :, None] * sel, nz), kinks, True, False)
+        gw = scatter_blocks(gw, edofs, lag_dofs, (n_x, n_n))
         gw = np.asarray(gw.sum(axis=1)).ravel()  # lag shape functions sum to one
         groups.append(StripGroup(float(b), pq, pd, gw[:n_q]))
         groups_r.append(StripGroup(float(b), pq_r, pd_r, gw[n_q:]))
 
     # lag fields: term-independent base matrices on the nodes
     Mz1 = scatter_blocks(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
-    Lz1 = scatter_blocks(
-        elem(nz, (1.0 / p["b"])[:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n)
-    )
-    E1 = split(elem(nz, aero.r_q[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
-    F1 = split(elem(nz, aero.r_d[:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
-    W1, W1_r = split(elem(N, aero.w[:, :, None], nz), edofs, lag_dofs, (n_x, n_n))
-    Mnc, Mnc_r = qq(aero.Mnc)
-    Cnc, Cnc_r = qq(aero.Cnc)
-    Knc, Knc_r = qq(aero.Knc)
+    Lz1 = scatter_blocks(elem(nz, c["inv_b"][:, None, None], nz), lag_dofs, lag_dofs, (n_n, n_n))
+    E1 = split(elem(nz, c["r_q"][:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    if c["r_g"] is not None:
+        E1 = E1 + split(elem(nz, c["r_g"][:, None, :], N1), lag_dofs, edofs, (n_n, n_x))[0]
+    F1 = split(elem(nz, c["r_d"][:, None, :], N), lag_dofs, edofs, (n_n, n_x))[0]
+    W1, W1_r = split(elem(N, c["w"][:, :, None], nz), edofs, lag_dofs, (n_x, n_n))
+    Mnc, Mnc_r = qq(c["Mnc"])
+    Cnc, Cnc_r = qq(c["Cnc"])
+    Knc, Knc_r = qq(c["Knc"])
 
     labels = tuple(str(i) for i in range(n_n))
     root = AeroMatrices(

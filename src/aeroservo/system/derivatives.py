@@ -15,6 +15,12 @@ stiffness, its station derivative ``k (n' n^T + n n'^T)`` with the flap's linear
 ``n`` of the element holding it. On a mesh node the discretized model has a kink in the station
 (the two elements give different one-sided derivatives): :func:`station_on_node` tells, and
 ``side`` picks the element.
+
+A concentrated mass's parameters move its point mass matrix only
+(:mod:`aeroservo.system.mass_derivatives`, with the same one-sided rule for its station); a
+mass on a control surface also moves with the segment's ``a`` and ``semichord`` and the
+surface's ``hinge`` (its distance from the elastic axis is ``b (c - a) + offset``), a term
+added to those parameters' ``Ms`` derivative.
 """
 
 from __future__ import annotations
@@ -33,14 +39,28 @@ from .assembly import (
     scatter_blocks,
     section_coefficients,
 )
+from .mass_derivatives import (
+    MASS_KEYS,
+    mass_coupling_derivative,
+    mass_station_kink,
+    point_mass_derivative,
+)
 from .matrices import AeroMatrices, StripGroup
+from .swept_assembly import gradient_shapes, kink_transforms, strip_coefficients, to_nodal
 
-__all__ = ["PARAMETERS", "matrix_derivative", "station_on_node", "zero_derivative"]
+__all__ = [
+    "PARAMETERS",
+    "matrix_derivative",
+    "station_on_node",
+    "station_kink",
+    "zero_derivative",
+]
 
 PARAMETERS = {
     "segment": ("mass", "x_alpha", "inertia", "EI", "GJ", "a", "semichord"),
     "surface": ("hinge", "static_moment", "inertia", "GJ", "hinge_stiffness"),
     "actuator": ("stiffness", "station"),
+    "mass": MASS_KEYS,
 }
 """Differentiable wing parameters by owner (wing-file keys)."""
 
@@ -60,7 +80,14 @@ to rounding for any small h; this one is far below every property's rounding).""
 
 
 def matrix_derivative(
-    wing: Wing, mesh: Mesh, owner: str, index: tuple[int, ...], key: str, *, side: int = 1
+    wing: Wing,
+    mesh: Mesh,
+    owner: str,
+    index: tuple[int, ...],
+    key: str,
+    *,
+    side: int = 1,
+    sweep_terms: str = "full",
 ) -> AeroMatrices:
     """Derivatives of the structural and aerodynamic matrices with respect to one parameter.
 
@@ -68,14 +95,17 @@ def matrix_derivative(
     ----------
     wing : Wing
     mesh : Mesh
-    owner : {"segment", "surface", "actuator"}
+    owner : {"segment", "surface", "actuator", "mass"}
     index : tuple of int
-        ``(i,)`` for ``segments[i]`` or ``control_surfaces[i]``, ``(k, j)`` for
+        ``(i,)`` for ``segments[i]``, ``control_surfaces[i]`` or ``masses[i]``, ``(k, j)`` for
         ``control_surfaces[k].actuators[j]``.
     key : str
         The wing-file key (:data:`PARAMETERS`).
     side : {1, -1}
-        For an actuator station on a mesh node: the element outboard (1) or inboard (-1).
+        For an actuator's or a mass's station on a mesh node: the element outboard (1) or
+        inboard (-1).
+    sweep_terms : {"full", "classical"}
+        Spanwise-convection terms of swept segments, as in the model's assembly.
 
     Returns
     -------
@@ -98,6 +128,9 @@ def matrix_derivative(
             )
             dk = actuator_stiffness(replace(wing, control_surfaces=surfaces), mesh, n_q)
         return _matrices(mesh, {"Ks": dk}, zero_q, zero_n)
+    if owner == "mass":  # the point mass matrix alone (mass_derivatives.py)
+        dm = point_mass_derivative(wing, mesh, index[0], key, side=side)
+        return _matrices(mesh, {"Ms": dm}, zero_q, zero_n)
 
     p = element_properties(wing, mesh)
     on = (mesh.segment if owner == "segment" else mesh.surface) == index[0]
@@ -105,39 +138,47 @@ def matrix_derivative(
     pc = {k: v.astype(complex) for k, v in p.items()}
     pc[prop] = pc[prop] + 1j * STEP * on
     ms, kd, kn, aero = section_coefficients(pc)
-    coef = {k: getattr(aero, k) for k in ("Mnc", "Cnc", "Knc", "Pq", "Pd", "w", "r_q", "r_d")}
-    coef["inv_b"] = 1.0 / pc["b"]
+    coef = strip_coefficients(wing, mesh, aero, pc["b"], sweep_terms)  # swept strips if swept
+    del coef["b"]  # the reduced frequency's semichord: the exact C(k) is not differentiated
     ms, kd, kn = (np.imag(x) / STEP for x in (ms, kd, kn))
-    aero = {k: np.imag(v) / STEP for k, v in coef.items()}
+    aero = {k: np.imag(v) / STEP for k, v in coef.items() if v is not None}
 
     # only the elements of the parameter's owner carry a derivative: integrate those
     L = mesh.lengths[on]
     xi, wts = gauss_rule()
-    N, D, _ = field_shapes(L, xi)
+    N, D, S = field_shapes(L, xi)
+    N1 = gradient_shapes(N, D, S)
     nz = lag_shapes(xi)[None, :, None, :].repeat(L.size, axis=0)
     dofs = mesh.element_dofs[on]  # the clamped root's unknowns are -1: dropped
     lag = np.flatnonzero(on)
     lag = np.stack([lag, lag + 1], axis=1)
     shapes = {"q": n_q, "z": n_n}
+    kinks = kink_transforms(wing, mesh)
+    kinks = None if kinks is None else kinks[on]
 
     def block(left, coef, right, rows="q", cols="q"):
         coef = coef[on]
         if not np.any(coef):
             return None
         blocks = integrate(L, wts, left, coef[:, None], right)
+        blocks = to_nodal(blocks, kinks, rows == "q", cols == "q")
         ri, ci = (dofs if k == "q" else lag for k in (rows, cols))
         return scatter_blocks(blocks, ri, ci, (shapes[rows], shapes[cols]))
 
+    on_masses = mass_coupling_derivative(wing, mesh, owner, index[0], key)  # on a surface
     parts = {
-        "Ms": block(N, ms, N),
+        "Ms": _sum(block(N, ms, N), on_masses),
         "Ks": _sum(block(D, kd, D), block(N, kn, N)),
         "Mnc": block(N, aero["Mnc"], N),
         "Cnc": block(N, aero["Cnc"], N),
         "Knc": block(N, aero["Knc"], N),
-        "Pq": block(N, aero["Pq"], N),
+        "Pq": _sum(block(N, aero["Pq"], N), _maybe(block, N, aero.get("Pg"), N1)),
         "Pd": block(N, aero["Pd"], N),
         "Lz1": block(nz, aero["inv_b"][:, None, None], nz, "z", "z"),
-        "E1": block(nz, aero["r_q"][:, None, :], N, "z"),
+        "E1": _sum(
+            block(nz, aero["r_q"][:, None, :], N, "z"),
+            _maybe(block, nz, _lag_row(aero.get("r_g")), N1, "z"),
+        ),
         "F1": block(nz, aero["r_d"][:, None, :], N, "z"),
         "W1": block(N, aero["w"][:, :, None], nz, "q", "z"),
     }
@@ -146,6 +187,15 @@ def matrix_derivative(
 
 def _sum(a, b):
     return b if a is None else a if b is None else a + b
+
+
+def _maybe(block, left, coef, right, rows="q"):
+    """``block(left, coef, right)``, or None without a coefficient (an unswept wing)."""
+    return None if coef is None else block(left, coef, right, rows)
+
+
+def _lag_row(r):
+    return None if r is None else r[:, None, :]
 
 
 def zero_derivative(mesh: Mesh) -> AeroMatrices:
@@ -183,6 +233,26 @@ def station_on_node(wing: Wing, mesh: Mesh, k: int, j: int) -> str | None:
     if abs(x - cs.start) <= tol or abs(x - cs.end) <= tol:
         return "edge"
     return "node" if np.any(np.abs(mesh.nodes - x) <= tol) else None
+
+
+def station_kink(
+    wing: Wing, mesh: Mesh, owner: str, index: tuple[int, ...]
+) -> tuple[str | None, int, str]:
+    """Where the station of an actuator (``index = (k, j)``) or a mass (``(i,)``) has no
+    two-sided derivative: ``("edge", inward side, why)`` on a bound of the station,
+    ``("node", 0, why)`` on an interior mesh node (two one-sided derivatives), ``("jump", 0,
+    why)`` where the matrices jump (no derivative), or ``(None, 1, "")``."""
+    if owner == "mass":
+        return mass_station_kink(wing, mesh, index[0])
+    where = station_on_node(wing, mesh, *index)
+    if where == "edge":  # the station may only move into its surface
+        cs = wing.control_surfaces[index[0]]
+        x = cs.actuators[index[1]].station
+        why = "at an end of its control surface (a bound of the station): one-sided"
+        return where, 1 if abs(x - cs.start) < abs(x - cs.end) else -1, why
+    if where == "node":
+        return where, 0, "on a mesh node: the discretized model has a kink there"
+    return None, 1, ""
 
 
 def _station_derivative(wing: Wing, mesh: Mesh, k: int, j: int, side: int) -> sp.csr_matrix:

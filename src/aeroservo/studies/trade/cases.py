@@ -16,6 +16,7 @@ import numpy as np
 from ...errors import InputError, check_number
 from ...structure.wing import Actuator, Wing
 from .grid import case_id
+from .mass_parameters import with_masses
 from .study import _DOMAINS, METRICS, PARAMETERS, TradeStudy
 
 __all__ = ["variant_wing", "evaluate_case"]
@@ -24,7 +25,8 @@ __all__ = ["variant_wing", "evaluate_case"]
 def variant_wing(study: TradeStudy, params: Mapping) -> Wing:
     """The base wing with the design parameters of ``params`` applied.
 
-    Controller parameters (``bryson_hinge_moment``, ``speed_factor``) are ignored here.
+    Controller parameters (``bryson_hinge_moment``, ``speed_factor``) are ignored here; the
+    concentrated masses' (``masses[i].mass`` ...) set the base wing's masses.
 
     Raises
     ------
@@ -35,8 +37,8 @@ def variant_wing(study: TradeStudy, params: Mapping) -> Wing:
     for k in params:
         if k != "case_id" and k not in PARAMETERS:
             raise InputError(f"parameters.{k}: unknown parameter; known are {sorted(PARAMETERS)}")
-    wing = study.base_wing
-    cs = study.surface
+    wing = with_masses(study.base_wing, params)
+    cs = wing.control_surfaces[0] if wing.control_surfaces else None
     span = wing.span
     kw: dict = {}
     if "aileron_start" in params:

@@ -49,39 +49,45 @@ from ...design.spec import ControllerSpec
 from ...errors import MAX_ELEMENTS, InputError, check_int, check_number
 from ...structure.wing import Wing
 from ...system.damping import NO_DAMPING, StructuralDamping
+from .mass_parameters import TradeParameters, check_mass_values, mass_parameter
 
 __all__ = ["PARAMETERS", "METRICS", "FORMAT", "TradeStudy"]
 
 FORMAT = "aeroservo-trade/2"
 """Version of the case and study files; part of every case id."""
 
-PARAMETERS: dict[str, tuple[str, str]] = {
-    "aileron_start": (
-        "-",
-        "fraction of the span where the aileron starts (it always ends at the tip)",
-    ),
-    "aileron_chord": (
-        "-",
-        "aileron chord as a fraction of the wing chord (hinge c = 1 - 2 f semichords aft of "
-        "mid-chord; aileron mass per unit area kept, so S_beta ~ f^2 and I_beta ~ f^3)",
-    ),
-    "hinge_stiffness": ("N m/rad/m", "distributed hinge stiffness per unit span"),
-    "actuator_station": (
-        "-",
-        "station of a single actuator as a fraction of the span (replaces the base actuators "
-        "by one of their total stiffness)",
-    ),
-    "bryson_hinge_moment": (
-        "N m",
-        "allowed hinge moment of Bryson's rule (replaces the controller's weights.inputs value "
-        "for every control)",
-    ),
-    "speed_factor": (
-        "-",
-        "design (and gust) speed as a multiple of the variant's open-loop flutter speed",
-    ),
-}
-"""Parameters a study can sweep: name -> (unit, description)."""
+PARAMETERS: dict[str, tuple[str, str]] = TradeParameters(
+    {
+        "aileron_start": (
+            "-",
+            "fraction of the span where the aileron starts (it always ends at the tip)",
+        ),
+        "aileron_chord": (
+            "-",
+            "aileron chord as a fraction of the wing chord (hinge c = 1 - 2 f semichords aft of "
+            "mid-chord; aileron mass per unit area kept, so S_beta ~ f^2 and I_beta ~ f^3)",
+        ),
+        "hinge_stiffness": ("N m/rad/m", "distributed hinge stiffness per unit span"),
+        "actuator_station": (
+            "-",
+            "station of a single actuator as a fraction of the span (replaces the base actuators "
+            "by one of their total stiffness)",
+        ),
+        "bryson_hinge_moment": (
+            "N m",
+            "allowed hinge moment of Bryson's rule (replaces the controller's weights.inputs value "
+            "for every control)",
+        ),
+        "speed_factor": (
+            "-",
+            "design (and gust) speed as a multiple of the variant's open-loop flutter speed",
+        ),
+    }
+)
+"""Parameters a study can sweep: name -> (unit, description); also ``masses[i].<key>`` of the
+base wing's concentrated masses, in wing-file units (:mod:`.mass_parameters`)."""
+
+_SURFACE = ("aileron_start", "aileron_chord", "hinge_stiffness", "actuator_station")  # aileron
 
 _DOMAINS: dict[str, dict] = {
     "aileron_start": {"lo": 0.0, "hi": 1.0, "hi_open": True},
@@ -223,17 +229,20 @@ class TradeStudy:
         w = self.base_wing
         if not isinstance(w, Wing):
             raise InputError(f"base_wing = {w!r}: expected an aeroservo.Wing")
-        if len(w.control_surfaces) != 1:
+        swept = self.parameters if isinstance(self.parameters, Mapping) else {}
+        aileron = self.closed_loop is not False or any(k in _SURFACE for k in swept)
+        if aileron and len(w.control_surfaces) != 1:
             raise InputError(
                 f"base_wing.control_surfaces: {len(w.control_surfaces)} surfaces; a trade study "
-                "needs a wing with exactly one control surface (the aileron)"
+                "needs a wing with exactly one control surface (the aileron), unless it is "
+                "open loop (closed_loop = false) and sweeps no aileron parameter"
             )
         if not isinstance(self.wagner, str):
             raise InputError(f"wagner = {self.wagner!r}: expected the name of a Wagner set")
         wagner_set(self.wagner)
         for key in ("controls", "sensors", "outputs"):
             put(self, key, _names(key, getattr(self, key)))
-        if not self.controls:
+        if not self.controls and self.closed_loop is not False:
             raise InputError("controls = (): give at least one control input")
         put(self, "elements", check_int("elements", self.elements, lo=1, hi=MAX_ELEMENTS))
         put(self, "n_grid", check_int("n_grid", self.n_grid, lo=3, hi=10_000))
@@ -294,12 +303,18 @@ class TradeStudy:
             if len(values) == 0:
                 raise InputError(f"parameters.{name} = []: give at least one value")
             unit = PARAMETERS[name][0]
-            dom = dict(_DOMAINS[name])
+            dom = dict(_DOMAINS.get(name, {}))
             if name == "speed_factor":
                 dom.update(hi=self.v_max_factor, hi_open=True)
-            vals = tuple(
-                check_number(f"parameters.{name}[{i}]", v, unit="" if unit == "-" else unit, **dom)
-                for i, v in enumerate(values)
+            vals = (
+                check_mass_values(self.base_wing, name, values)
+                if mass_parameter(name) is not None
+                else tuple(
+                    check_number(
+                        f"parameters.{name}[{i}]", v, unit="" if unit == "-" else unit, **dom
+                    )
+                    for i, v in enumerate(values)
+                )
             )
             if len(set(vals)) != len(vals):
                 dup = sorted({v for v in vals if vals.count(v) > 1})
