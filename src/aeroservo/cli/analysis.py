@@ -89,6 +89,11 @@ def add_parsers(sub) -> None:
     m.add_argument(
         "--animate", metavar="FILE.gif", help="animation of mode N (default 1) at the tip"
     )
+    m.add_argument(
+        "--planform",
+        metavar="FILE",
+        help="top view of the wing: sweep, control surfaces, actuators, masses (png, pdf, svg)",
+    )
 
 
 def _wing_text(spec: str, wing) -> str:
@@ -216,6 +221,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 
     check_figure(args.plot)
     check_suffix("--animate", args.animate, ".gif")
+    check_figure(args.planform, "--planform")
     wing, opts = resolve_wing(args.wing)
     with named("n_elements", "--elements" if args.elements else None, args, "elements"):
         model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
@@ -223,7 +229,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     modes = model.natural_modes(min(max(args.n, args.mode or 1), model.n_dofs))
     if args.mode is not None and args.mode > modes.frequencies.size:
         raise InputError(f"--mode = {args.mode}: the model has {modes.frequencies.size} modes")
-    if args.plot or args.animate:
+    if args.plot or args.animate or args.planform:
         _mode_figures(args, model, modes)
     if args.json:
         print(
@@ -245,7 +251,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 
 
 def _mode_figures(args: argparse.Namespace, model, modes) -> None:
-    """The ``--plot`` and ``--animate`` files of ``aeroservo modes`` (written as a set)."""
+    """The ``--plot``, ``--animate`` and ``--planform`` files of ``aeroservo modes`` (written
+    as a set)."""
     from ..atomic import atomic_write_set, figure_writer
     from ..plots.modes import gif_writer, plot_modes, strain_energy_shares
 
@@ -267,6 +274,11 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
             masses={pm.name: pm.station for pm in model.wing.masses},
         )
         writers.append((args.plot, figure_writer(fig, args.plot, dpi=130)))
+    if args.planform:
+        from ..plots.planform import plot_planform
+
+        fig = plot_planform(model.wing)
+        writers.append((args.planform, figure_writer(fig, args.planform, dpi=130)))
     if args.animate:
         j = (args.mode or 1) - 1
         kw = {"label": modes.labels[j], "frequency": float(modes.frequencies[j])}

@@ -1,5 +1,6 @@
 """Figures of single results: V-g / V-f diagrams, root loci, flutter envelopes (:mod:`.flutter`),
-mode shapes and their animation (:mod:`.modes`) and loop margins (:mod:`.margins`).
+mode shapes and their animation (:mod:`.modes`), the planform (:mod:`.planform`) and loop
+margins (:mod:`.margins`).
 
 Functions return :class:`matplotlib.figure.Figure` objects made by
 :func:`aeroservo._figures.new_figure`: when pyplot is in use (imported) the figure is the current
@@ -18,6 +19,7 @@ _PUBLIC = {
     "animate_mode": "modes",
     "plot_mode_shapes": "modes",
     "plot_modes": "modes",
+    "plot_planform": "planform",
     "plot_root_locus": "flutter",
     "plot_sensitivities": "sensitivity",
     "plot_vg": "flutter",
@@ -28,6 +30,7 @@ __all__ = [
     "plot_root_locus",
     "plot_mode_shapes",
     "plot_modes",
+    "plot_planform",
     "animate_mode",
     "plot_envelope",
     "plot_loop_margins",
