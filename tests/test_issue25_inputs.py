@@ -245,3 +245,29 @@ def test_duration_times_rate_over_the_limit_names_file_and_keys(tmp_path, capsys
     assert code == 2
     assert str(p) in err and "simulation.duration" in err and "simulation.sample_rate" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_export_with_compressibility_is_the_flutter_commands_model(tmp_path, capsys):
+    """Review finding: a file asking for Prandtl-Glauert was exported incompressible. At 200 m/s
+    and 10 km (Mach 0.668) the corrected model is unstable (flutter 198.07 m/s) and the
+    incompressible one is not."""
+    body = GOLAND.split("[analysis]")[0]
+    pg = wing_file(
+        tmp_path,
+        '[analysis]\naltitude = 10000.0\ncompressibility = "prandtl-glauert"\n',
+        "pg.toml",
+        body,
+    )
+    code, out, _ = run(capsys, "flutter", pg, "--json")
+    assert code == 0 and json.loads(out)["flutter_speed"] < 200.0
+    code, out, _ = run(capsys, "export", pg, "--speed", "200", "--out", tmp_path / "pg.npz")
+    assert code == 0 and "Prandtl-Glauert at Mach 0.6679" in out
+    A = np.load(tmp_path / "pg.npz")["A"]
+    assert np.linalg.eigvals(A).real.max() > 0  # unstable above its flutter speed
+    case = aes.load_model(pg)
+    np.testing.assert_allclose(case.statespace(200.0).A, A, rtol=1e-12, atol=1e-12 * abs(A).max())
+    beta = np.sqrt(1 - case.mach_at(200.0) ** 2)
+    assert case.mach_at(200.0) == pytest.approx(200.0 / case.atmosphere.speed_of_sound)
+    assert 0 < beta < 1
+    plain = aes.statespace(case.model, 200.0, case.density)
+    assert np.linalg.eigvals(plain.A).real.max() < 0  # the incompressible model differs

@@ -572,3 +572,18 @@ def test_cli_import(tmp_path):
         cwd=tmp_path,
     )
     assert run.returncode == 2 and "not allowed with argument" in run.stderr
+
+
+def test_orientation_written_as_integers_is_one_line(tmp_path):
+    """Review finding: ``CBAR,1,1,1,2,0,0,1`` (pyNastran's writer makes it from x=[0, 0, 1])
+    reads field 6 as grid G0 = 0 and no vector: one line naming the element, not a traceback."""
+    path = _base(tmp_path, name="g0.bdf")
+    lines = path.read_text().splitlines()
+    first = next(i for i, ln in enumerate(lines) if ln.startswith("CBAR"))
+    end = next(i for i in range(first + 1, len(lines)) if not lines[i].startswith("*"))
+    lines[first:end] = ["CBAR,1,1,1,2,0,0,1"]
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError) as info:
+        import_nastran(path, semichord=SEMICHORD, elastic_axis=A_EA)
+    msg = str(info.value)
+    assert "\n" not in msg and "G0 = 0" in msg and str(path) in msg, msg

@@ -180,3 +180,19 @@ def test_near_critical_on_the_vg_plot_and_in_the_saved_sweep(tmp_path, capsys):
     assert code == 0
     back = load_result(tmp_path / "s.npz").result
     assert back.near_critical == r.near_critical
+
+
+@pytest.mark.parametrize(("v_max", "found"), [(77.5, True), (76.0, True), (75.5, False)])
+def test_a_minimum_inside_the_last_searched_interval_is_found(v_max, found):
+    """Review finding: with v_max just past the minimum (75.70 m/s) the last grid point was
+    never a candidate. The minimum is reported when it lies inside the searched range, with
+    its range cut at v_max; below it zeta is still falling and nothing is reported."""
+    r = aes.flutter_boundary(model(0.01), RHO, v_max=v_max)
+    if not found:
+        assert r.near_critical == []
+        return
+    (n,) = r.near_critical
+    full = boundary(0.01).near_critical[0]
+    assert n.damping_ratio == pytest.approx(full.damping_ratio, abs=1e-9)
+    assert n.speed_range[0] == pytest.approx(full.speed_range[0], rel=1e-6)
+    assert n.speed_range[1] == pytest.approx(min(full.speed_range[1], v_max), rel=1e-6)

@@ -12,6 +12,7 @@ from .errors import InputError
 
 _PUBLIC = {
     "AeroelasticModel": "system.aeroelastic",
+    "ConcentratedMass": "structure.masses",
     "Actuator": "structure.wing",
     "ControlSurface": "structure.wing",
     "FlutterResult": "stability.result",

@@ -32,7 +32,8 @@ def add_parsers(sub) -> None:
         "wing of a scenario file, at a density or an altitude (docs/stability.md).",
     )
     f.add_argument(
-        "wing", help="built-in wing (goland, goland_aileron), a wing .toml or a scenario .toml"
+        "wing",
+        help="built-in wing (aeroservo examples lists them), a wing .toml or a scenario .toml",
     )
     f.add_argument("--json", action="store_true", help="print one JSON object")
     add_flight_options(f)
@@ -78,7 +79,7 @@ def add_parsers(sub) -> None:
         "wing file, each mode named by its dominant motion (bending, torsion, control-surface "
         "rotation).",
     )
-    m.add_argument("wing", help="built-in wing (goland, goland_aileron) or a wing .toml")
+    m.add_argument("wing", help="built-in wing (aeroservo examples lists them) or a wing .toml")
     m.add_argument(
         "--elements", type=elements, help="beam elements (default: the wing file's, else 10)"
     )

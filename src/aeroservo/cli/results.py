@@ -296,6 +296,11 @@ def _cmd_export(args: argparse.Namespace) -> int:
     n_modes = None
     if args.design_modes is not None:
         n_modes = check_int("--design-modes", args.design_modes, lo=1, hi=s.model.n_dofs)
+    mach = 0.0
+    if s.compressibility is not None:  # Prandtl-Glauert at the export's own Mach number
+        from ..system.first_order import check_mach
+
+        mach = check_mach(args.speed / s.atmosphere.speed_of_sound, "--speed / speed of sound")
     sys = statespace(
         s.model,
         args.speed,
@@ -304,11 +309,14 @@ def _cmd_export(args: argparse.Namespace) -> int:
         args.outputs,
         n_modes=n_modes,
         balanced=not args.physical,
+        mach=mach,
     )
     (export_mat if suffix == ".mat" else export_npz)(sys, args.out)
     print(
         f"{s.wing.name} at {args.speed:g} m/s, {s.density:.5g} kg/m^3: {sys.nstates} states, "
-        f"inputs {list(sys.input_labels)}, outputs {list(sys.output_labels)} -> {args.out}"
+        f"inputs {list(sys.input_labels)}, outputs {list(sys.output_labels)}"
+        + (f", Prandtl-Glauert at Mach {mach:.4g}" if mach else "")
+        + f" -> {args.out}"
     )
     return 0
 

@@ -249,6 +249,11 @@ def _extract(path: Path, model) -> Deck:
         g0 = getattr(elem, "g0", None) or None
         v = None
         if g0 is None:
+            if getattr(elem, "x", None) is None:
+                raise InputError(
+                    f"{where}: no orientation vector (field 6 read as grid G0 = 0: write X1, X2, "
+                    "X3 as real numbers, e.g. 0., 0., 1.)"
+                )
             x = np.asarray(elem.x, dtype=float)
             v = x if offt[0] == "B" else cd_axes[ga].T @ x
         mat = model.materials[model.properties[elem.pid].mid]

@@ -80,11 +80,22 @@ class WingModel:
 
         return flutter_boundary(self.model, self.density, **kw)
 
+    def mach_at(self, speed: float) -> float:
+        """Mach number of the file's compressibility correction at ``speed`` [m/s] (0 without
+        one): ``V / a`` at the file's altitude, as ``aeroservo export`` uses it."""
+        if self.compressibility is None or self.atmosphere is None:
+            return 0.0
+        from ..system.first_order import check_mach
+
+        return check_mach(speed / self.atmosphere.speed_of_sound, "mach (speed / a)")
+
     def statespace(self, speed: float, inputs=None, outputs=None, **kw):
-        """The linear model at ``speed`` [m/s] and the file's density, as ``aeroservo export``
-        writes it (structural damping included); arguments as :func:`aeroservo.statespace`."""
+        """The linear model at ``speed`` [m/s] and the file's density (and Mach number, with
+        the file's compressibility), as ``aeroservo export`` writes it (structural damping
+        included); arguments as :func:`aeroservo.statespace`."""
         from ..linear.models import statespace
 
+        kw.setdefault("mach", self.mach_at(speed))
         return statespace(self.model, speed, self.density, inputs, outputs, **kw)
 
 

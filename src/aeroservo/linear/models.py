@@ -82,6 +82,7 @@ def statespace(
     kussner: object = "sears_sparks",
     n_modes: int | None = None,
     balanced: bool = True,
+    mach: float = 0.0,
 ):
     """Linear state-space model of a wing at one flight condition.
 
@@ -102,6 +103,8 @@ def statespace(
         True (default): diagonally scaled states (same transfer function and state names,
         ``x_physical = sys.state_scaling * x``); False: the physical states, see
         :meth:`StateSpaceBuilder.at`.
+    mach : float
+        Mach number of the Prandtl-Glauert correction (0: incompressible; below 0.9).
 
     Returns
     -------
@@ -112,10 +115,20 @@ def statespace(
     check_number("speed", speed, unit="m/s", lo=0.0, hi=MAX_SPEED)
     _check_bool("balanced", balanced)
     model = _model_for(wing, n_elements, wagner)
+    kw = {"mach": mach} if mach else {}  # the cached incompressible builder otherwise
     b = _builder_for(
-        model, density, inputs, outputs, servo=servo, gust=gust, kussner=kussner, n_modes=n_modes
+        model,
+        density,
+        inputs,
+        outputs,
+        servo=servo,
+        gust=gust,
+        kussner=kussner,
+        n_modes=n_modes,
+        **kw,
     )
-    note = mach_note("the model", speed, isa_at_density(density).speed_of_sound, assumed=True)
+    a = isa_at_density(density).speed_of_sound
+    note = None if mach else mach_note("the model", speed, a, assumed=True)
     if note:
         import warnings
 

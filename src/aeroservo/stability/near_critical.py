@@ -91,23 +91,33 @@ def near_critical(
     z = -lam.real / np.maximum(np.abs(lam), 1e-300)
     # screened on the modal values (interior minima, V = 0 and its neighbour excluded),
     # decided on the full model
+    n = int(np.searchsorted(V, top, side="right"))  # grid points inside the searched range
     cand = np.zeros(lam.shape, dtype=bool)
-    cand[2:-1] = (osc[1:-2] & osc[2:-1] & osc[3:] & (z[2:-1] <= z[1:-2]) & (z[2:-1] <= z[3:])) & (
-        np.abs(z[2:-1]) < HUMP_ZETA
-    )
+    cand[2 : n - 1] = (
+        osc[1 : n - 2] & osc[2 : n - 1] & osc[3:n]
+        & (z[2 : n - 1] <= z[1 : n - 2]) & (z[2 : n - 1] <= z[3:n])
+    )  # fmt: skip
+    # the last searched point too: a minimum can lie inside the last interval
+    cand[n - 1] = osc[n - 2] & osc[n - 1] & (z[n - 1] <= z[n - 2]) if n >= 3 else False
+    cand &= np.abs(z) < HUMP_ZETA
     out = []
     for k, j in np.argwhere(cand).tolist():
+        last = k == n - 1
         try:
-            zk = [_zeta(ver.at(kk, j)) for kk in (k - 1, k, k + 1)]
-            if zk[1] <= zk[0] and zk[1] <= zk[2] and 0.0 < zk[1] < HUMP_ZETA:
-                out += _refine(ver, j, k, zk[1], rtol, threshold)
+            zk = [_zeta(ver.at(kk, j)) for kk in (k - 1, k) + (() if last else (k + 1,))]
+            if zk[1] <= zk[0] and zk[1] <= zk[-1] and 0.0 < zk[1] < HUMP_ZETA:
+                out += _refine(ver, j, k, zk[1], rtol, threshold, last, top)
         except VerificationError:
             continue  # not decided here; the search itself reports such a branch
     return sorted(out, key=lambda n: n.speed)
 
 
-def _refine(ver: Verifier, j: int, k: int, z_k: float, rtol: float, thr: float) -> list:
-    """The minimum of zeta around grid point k on the full model, if it is near-critical."""
+def _refine(
+    ver: Verifier, j: int, k: int, z_k: float, rtol: float, thr: float, last: bool, top: float
+) -> list:
+    """The minimum of zeta around grid point k on the full model, if it is near-critical (at
+    the last searched point ``last``: only a minimum inside the last interval, not one at the
+    end of the search, where zeta may go on falling)."""
     from scipy.optimize import minimize_scalar
 
     V = ver.br.speeds
@@ -115,17 +125,20 @@ def _refine(ver: Verifier, j: int, k: int, z_k: float, rtol: float, thr: float) 
     def zeta(v: float) -> float:
         return _zeta(ver.follow(j, k - 1 if v < V[k] else k, v))
 
+    hi = V[k] if last else V[k + 1]
     sol = minimize_scalar(
-        zeta, bounds=(V[k - 1], V[k + 1]), method="bounded", options={"xatol": rtol * V[k]}
+        zeta, bounds=(V[k - 1], hi), method="bounded", options={"xatol": rtol * V[k]}
     )
     v0, z0 = float(sol.x), float(sol.fun)
-    if z_k < z0:
+    if last and v0 > V[k] - 10 * rtol * V[k]:
+        return []  # still falling at the end of the search: not a minimum
+    if not last and z_k < z0:
         v0, z0 = float(V[k]), z_k
     if not 0.0 < z0 <= thr:
         return []  # a crossing (found as one) or not near
     lo, hi = _edge(ver, j, v0, -1, thr, rtol), _edge(ver, j, v0, +1, thr, rtol)
     f0 = abs(ver.follow(j, k - 1 if v0 < V[k] else k, v0).imag) / (2 * np.pi)
-    return [NearCritical(v0, f0, z0, (lo, hi), j, thr)]
+    return [NearCritical(v0, f0, z0, (lo, min(hi, top)), j, thr)]
 
 
 def _edge(ver: Verifier, j: int, v0: float, step: int, thr: float, rtol: float) -> float:
@@ -187,9 +200,9 @@ def method_discrepancy(
     def text(r: FlutterResult) -> str:
         if r.flutter_speed is None:
             return f"no flutter below {r.searched_up_to:.4g} m/s"
-        return f"{r.flutter_speed:.4g} m/s ({r.flutter_frequency:.4g} Hz)"
+        return f"flutter {r.flutter_speed:.4g} m/s ({r.flutter_frequency:.4g} Hz)"
 
-    lines = f"time-domain flutter {text(td)} and p-k (exact C(k)) flutter {text(pk)} differ"
+    lines = f"time-domain {text(td)} and p-k (exact C(k)) {text(pk)} differ"
     if vt is not None and vp is not None:
         lines += f" by {100 * abs(vt - vp) / min(vt, vp):.3g} %"
     ks = [
