@@ -1,6 +1,6 @@
 """Strip aerodynamics independent of the structure: Theodorsen's thin-airfoil theory with a
 flap (:mod:`.theodorsen`), Wagner and Kussner indicial functions (:mod:`.indicial`) and gust
-velocity fields (:mod:`.gusts`).
+velocity fields (:mod:`.gusts`), the numbers of the gust rule CS-25.341(a) (:mod:`.gust_rules`).
 """
 
 from .._lazy import lazy_attributes
@@ -12,7 +12,11 @@ _PUBLIC = {
     "OneMinusCosine": "gusts",
     "Turbulence": "gusts",
     "WAGNER_SETS": "indicial",
+    "design_gust_velocity": "gust_rules",
+    "flight_profile_alleviation": "gust_rules",
+    "gust_tas": "gust_rules",
     "kussner_set": "indicial",
+    "reference_gust_velocity": "gust_rules",
     "section_aero": "theodorsen",
     "theodorsen_function": "theodorsen",
     "wagner_set": "indicial",
@@ -25,7 +29,11 @@ __all__ = [
     "OneMinusCosine",
     "Turbulence",
     "WAGNER_SETS",
+    "design_gust_velocity",
+    "flight_profile_alleviation",
+    "gust_tas",
     "kussner_set",
+    "reference_gust_velocity",
     "section_aero",
     "theodorsen_function",
     "wagner_set",

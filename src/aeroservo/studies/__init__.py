@@ -9,6 +9,7 @@ _PUBLIC = {
     "Scenario": "scenario",
     "quick": "scenario",
     "run_scenario": "runs",
+    "tuned_gust_loads": "tuned_gusts",
 }
 
 __all__ = [
@@ -16,6 +17,7 @@ __all__ = [
     "Scenario",
     "quick",
     "run_scenario",
+    "tuned_gust_loads",
 ]
 
 __getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)
