@@ -167,15 +167,21 @@ def study() -> trade.TradeStudy:
     )
 
 
+def timed_trade(address: str, out: Path, cwd: Path):
+    """``aeroservo trade`` of the quick study on the scheduler at ``address``, and how long it
+    took [s]."""
+    t0 = time.monotonic()
+    r = run_cli(
+        "trade", str(SCENARIO), "--quick", "--out", str(out), "--scheduler", address, cwd=cwd
+    )
+    return r, time.monotonic() - t0
+
+
 @pytest.mark.slow
 def test_no_scheduler_at_address(tmp_path, study):
     address = f"tcp://127.0.0.1:{free_port()}"
     out = tmp_path / "out"
-    t0 = time.monotonic()
-    r = run_cli(
-        "trade", str(SCENARIO), "--quick", "--out", str(out), "--scheduler", address, cwd=tmp_path
-    )
-    elapsed = time.monotonic() - t0
+    r, elapsed = timed_trade(address, out, tmp_path)
     assert r.returncode == 2, r.stderr
     line = one_line(r.stderr)
     assert line.startswith("aeroservo: error: ") and address in line, line
@@ -193,11 +199,7 @@ def test_no_scheduler_at_address(tmp_path, study):
 def test_scheduler_without_workers(procs, tmp_path, study):
     address = scheduler(procs)
     out = tmp_path / "out"
-    t0 = time.monotonic()
-    r = run_cli(
-        "trade", str(SCENARIO), "--quick", "--out", str(out), "--scheduler", address, cwd=tmp_path
-    )
-    elapsed = time.monotonic() - t0
+    r, elapsed = timed_trade(address, out, tmp_path)
     assert r.returncode == 2, r.stderr
     line = one_line(r.stderr)
     assert f"scheduler = '{address}' has no workers (waited 10 s)" in line, line

@@ -296,11 +296,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
     n_modes = None
     if args.design_modes is not None:
         n_modes = check_int("--design-modes", args.design_modes, lo=1, hi=s.model.n_dofs)
-    mach = 0.0
-    if s.compressibility is not None:  # Prandtl-Glauert at the export's own Mach number
-        from ..system.first_order import check_mach
+    from ..files.wing_model import correction_mach
 
-        mach = check_mach(args.speed / s.atmosphere.speed_of_sound, "--speed / speed of sound")
+    # Prandtl-Glauert (when asked for) at the export's own Mach number
+    mach = correction_mach(args.speed, s.atmosphere, s.compressibility, "--speed / speed of sound")
     sys = statespace(
         s.model,
         args.speed,

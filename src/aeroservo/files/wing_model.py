@@ -22,7 +22,7 @@ from ..structure.wing import Wing
 from ..system.aeroelastic import AeroelasticModel
 from .wing_file import AnalysisOptions, resolve_wing
 
-__all__ = ["WingModel", "load_model"]
+__all__ = ["WingModel", "correction_mach", "load_model"]
 
 
 @dataclass(frozen=True)
@@ -83,11 +83,7 @@ class WingModel:
     def mach_at(self, speed: float) -> float:
         """Mach number of the file's compressibility correction at ``speed`` [m/s] (0 without
         one): ``V / a`` at the file's altitude, as ``aeroservo export`` uses it."""
-        if self.compressibility is None or self.atmosphere is None:
-            return 0.0
-        from ..system.first_order import check_mach
-
-        return check_mach(speed / self.atmosphere.speed_of_sound, "mach (speed / a)")
+        return correction_mach(speed, self.atmosphere, self.compressibility, "mach (speed / a)")
 
     def statespace(self, speed: float, inputs=None, outputs=None, **kw):
         """The linear model at ``speed`` [m/s] and the file's density (and Mach number, with
@@ -97,6 +93,18 @@ class WingModel:
 
         kw.setdefault("mach", self.mach_at(speed))
         return statespace(self.model, speed, self.density, inputs, outputs, **kw)
+
+
+def correction_mach(
+    speed: float, atmosphere: Atmosphere | None, compressibility: str | None, field: str = "mach"
+) -> float:
+    """The Mach number of a linear model at ``speed`` [m/s]: ``V / a`` of the atmosphere with
+    a compressibility correction, 0 without one (``field`` names it in the error at Mach 0.9)."""
+    if compressibility is None or atmosphere is None:
+        return 0.0
+    from ..system.first_order import check_mach
+
+    return check_mach(speed / atmosphere.speed_of_sound, field)
 
 
 def load_model(

@@ -315,36 +315,16 @@ def _pareto(table, name: str, names: Sequence[str] = (), best: int | None = None
     ax = fig.subplots()
     plain = usable & ~front & ~bound & ~unstable
     ax.scatter(peak[plain], margin[plain], s=18, color="C0", alpha=0.6, label="case")
-    if (bound & usable & ~front).any():
-        b = bound & usable & ~front
-        ax.scatter(
-            peak[b],
-            margin[b],
-            marker="^",
-            s=30,
-            color="C2",
-            label="stable to search limit (\u2265)",
-        )
-    if unstable.any():
-        ax.scatter(
-            peak[unstable],
-            margin[unstable],
-            marker="x",
-            s=30,
-            color="C3",
-            label="unstable at design speed",
-        )
-    if sat.any():
-        ax.scatter(
-            peak[sat],
-            margin[sat],
-            marker="s",
-            s=70,
-            facecolors="none",
-            edgecolors="red",
-            lw=1.0,
-            label="actuator saturated in the gust",
-        )
+    marks = (  # (cases, scatter style, legend)
+        (bound & usable & ~front, {"marker": "^", "s": 30, "color": "C2"},
+         "stable to search limit (\u2265)"),
+        (unstable, {"marker": "x", "s": 30, "color": "C3"}, "unstable at design speed"),
+        (sat, {"marker": "s", "s": 70, "facecolors": "none", "edgecolors": "red", "lw": 1.0},
+         "actuator saturated in the gust"),
+    )  # fmt: skip
+    for mask, style, label in marks:
+        if mask.any():
+            ax.scatter(peak[mask], margin[mask], label=label, **style)
     if front.any():
         order = np.flatnonzero(front)[np.argsort(peak[front])]
         ax.plot(peak[order], margin[order], "o-", color="C1", ms=6, label="Pareto front")
