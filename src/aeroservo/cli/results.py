@@ -10,7 +10,8 @@ from .options import add_flight_options, add_model_options, positive_float, quan
 __all__ = ["add_parsers", "HANDLERS"]
 
 FLUTTER_KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
-KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope")
+GUST_KINDS = ("envelope", "correlated", "critical-gusts")
+KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope", *GUST_KINDS[1:])
 
 
 def _mode_list(text: str) -> list[int]:
@@ -34,14 +35,18 @@ def add_parsers(sub) -> None:
     """The parsers of ``plot`` and ``export``."""
     pl = sub.add_parser(
         "plot",
-        help="redraw a saved result: flutter sweep, simulation, trade study or envelope",
+        help="redraw a saved result: flutter sweep, simulation, trade study, envelope or gust "
+        "loads",
         description="Redraw a result: a sweep saved by 'aeroservo flutter --save' (kinds vg, "
         "vf, root-locus, modes, flutter-mode), a simulation written by 'aeroservo simulate' "
         "(time), a trade study's folder (pareto, heatmap: --metric and --slice choose the "
         "metric and the other parameters' values) or an envelope saved by 'aeroservo envelope "
-        "--save' (envelope).",
+        "--save' (envelope) or gust loads written by 'aeroservo loads' (RESULT.json: envelope, "
+        "correlated, critical-gusts; all of them without --kind and --out).",
     )
-    pl.add_argument("result", help="result file (.npz, envelope .json) or trade folder")
+    pl.add_argument(
+        "result", help="result file (.npz, envelope or gust-loads .json) or trade folder"
+    )
     pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
     pl.add_argument("--kind", choices=KINDS, help="figure (default: vg, time, pareto, envelope)")
     pl.add_argument(
@@ -91,7 +96,6 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
     from ..atomic import save_figure
     from ..errors import InputError
-    from ..files.results import load_result
     from ..files.user_files import check_readable
     from .options import check_figure
 
@@ -110,7 +114,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         from ..atomic import check_output_path
 
         check_output_path(out, "--out")
-    res = load_result(src)
+    res = _load(src)
     what, kinds = _what(res)
     heat = args.metric is not None or args.slice is not None
     kind = args.kind or ("heatmap" if heat and "heatmap" in kinds else kinds[0])
@@ -124,6 +128,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         return _animate_saved(res, args, out)
     if what != "a flutter sweep" and (args.fmax or args.modes or args.eas):
         raise InputError(f"--fmax, --modes and --eas apply to flutter sweeps, not to {what}")
+    if kinds == GUST_KINDS:
+        return _gust_figures(res, src, args, kind)
     if kind in FLUTTER_KINDS:
         fig = _flutter_figure(res, kind, args)
     elif kind == "time":
@@ -221,8 +227,42 @@ def _slice(text: str, parameters: dict) -> dict:
     return out
 
 
+def _load(src):
+    """A saved result: gust loads (:func:`~aeroservo.files.gust_loads_file.load_gust_loads`)
+    or any other (:func:`~aeroservo.files.results.load_result`)."""
+    from ..files.gust_loads_file import is_gust_loads_file, load_gust_loads
+    from ..files.results import load_result
+
+    return load_gust_loads(src) if is_gust_loads_file(src) else load_result(src)
+
+
+def _gust_figures(res, src, args: argparse.Namespace, kind: str) -> int:
+    """The figures of saved gust loads: all of them next to the result (as ``aeroservo loads``
+    names them), or ``--kind`` alone (to ``--out``)."""
+    from pathlib import Path
+
+    from ..atomic import save_figure
+    from ..errors import InputError
+    from ..studies.gust_scenario import FIGURES, gust_figures
+
+    which = FIGURES if args.kind is None and args.out is None else (kind.replace("-", "_"),)
+    figs = gust_figures(res, which)
+    if not figs:
+        raise InputError(
+            f"--kind = {kind!r}: {args.result} has not both root_bending_moment and root_torque "
+            "as loads"
+        )
+    for name, fig in figs.items():
+        out = Path(args.out) if args.out else src.with_name(f"{src.stem}_{name}.png")
+        save_figure(fig, out, dpi=130)
+        print(f"plot written to {out}")
+    return 0
+
+
 def _what(res) -> tuple[str, tuple]:
     """What a loaded result is, and the figure kinds it has (default first)."""
+    if hasattr(res, "alleviation"):
+        return "gust loads", GUST_KINDS
     if hasattr(res, "pk"):
         return "a flutter sweep", FLUTTER_KINDS
     if hasattr(res, "pareto"):

@@ -14,7 +14,7 @@ __all__ = ["add_parsers", "HANDLERS"]
 def add_parsers(sub) -> None:
     """The scenario commands' parsers."""
     for name, helptext in (
-        ("run", "run a scenario of any kind (flutter, simulate, trade)"),
+        ("run", "run a scenario of any kind (flutter, simulate, trade, gust_loads)"),
         ("simulate", "run a closed-loop time simulation scenario"),
         ("trade", "run a trade-study scenario on Dask"),
     ):
@@ -58,7 +58,7 @@ def _cmd_examples(args: argparse.Namespace) -> int:
     if found:
         print(f"scenarios ({found[0][0].parent}):")
         for path, kind, title in found:
-            print(f"  {path.name:32s} {kind:9s} {title}")
+            print(f"  {path.name:32s} {kind:10s} {title}")
         wings = []
         for path in sorted(found[0][0].parent.glob("*.toml")):
             try:
@@ -85,10 +85,14 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     scenario = load_scenario(args.scenario)
     if args.command != "run" and scenario.kind != args.command:
+        use = {"flutter": "run", "gust_loads": "loads"}.get(scenario.kind, scenario.kind)
         raise InputError(
-            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo "
-            f"{'run' if scenario.kind == 'flutter' else scenario.kind}' for it"
+            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it"
         )
+    if scenario.kind == "gust_loads":  # 'aeroservo run': as 'aeroservo loads' does
+        from .loads import run_loaded
+
+        return run_loaded(scenario, args)
     if args.quick:
         scenario = quick(scenario)
     if not args.out.strip():

@@ -11,12 +11,14 @@ _PUBLIC = {
     "export_npz": "statespace_export",
     "WingModel": "wing_model",
     "load_controller": "controller_file",
+    "load_gust_loads": "gust_loads_file",
     "load_model": "wing_model",
     "load_result": "results",
     "load_scenario": "scenario_file",
     "load_wing": "wing_file",
     "resolve_wing": "wing_file",
     "save_result": "results",
+    "write_gust_loads": "gust_loads_file",
     "write_run": "outputs",
 }
 
@@ -25,12 +27,14 @@ __all__ = [
     "export_mat",
     "export_npz",
     "load_controller",
+    "load_gust_loads",
     "load_model",
     "load_result",
     "load_scenario",
     "load_wing",
     "resolve_wing",
     "save_result",
+    "write_gust_loads",
     "write_run",
 ]
 

@@ -7,7 +7,11 @@ speed, the engaged range shaded) and ``<result>_margin_sweep.png`` (margins acro
 range) for a controlled linear loop, and ``<result>.json``; a trade study writes
 ``summary.json``, ``heatmap_<metric>.png`` (one per metric of
 :data:`aeroservo.studies.trade.plots.HEATMAP_METRICS`) and ``pareto.png`` into its folder
-``<result>/`` (next to its case store, ``<result>.csv`` and ``<result>.nc``). Every file of a
+``<result>/`` (next to its case store, ``<result>.csv`` and ``<result>.nc``); gust loads write
+``<result>.json`` (summary and every record), ``<result>.npz`` (critical-gust histories),
+``<result>.csv`` (limit loads), ``<result>_alleviation.csv`` (both loops) and the figures
+``<result>_envelope.png``, ``<result>_correlated.png`` and ``<result>_critical_gusts.png``
+(:mod:`aeroservo.files.gust_loads_file`). Every file of a
 run is renamed into place only when all of them have been written
 (:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
 """
@@ -99,6 +103,19 @@ def _write_run(run: Run, out: Path) -> dict[str, str]:
 
         json_path = out / f"{sc.result}.json"
         files["summary"] = str(json_path)
+    elif sc.kind == "gust_loads":
+        from ..studies.gust_scenario import gust_figures
+        from .gust_loads_file import gust_loads_items
+
+        data = gust_loads_items(run.loads, out / f"{sc.result}.json", summary)
+        for kind, (path, writer) in data.items():
+            add(kind, path, writer)  # the JSON's text is made when written, files included
+        for name, fig in gust_figures(run.loads).items() if plots else ():
+            png = out / f"{sc.result}_{name}.png"
+            add(f"{name}_plot", png, figure_writer(fig, png, dpi=120))
+        summary["files"] = files
+        atomic_write_set(items)
+        return files
     else:
         res, folder = run.trade, run.folder
         files["csv"], files["netcdf"] = str(res.csv_path), str(res.netcdf_path)

@@ -99,7 +99,8 @@ def _load_envelope(path: Path):
 def load_result(path: str | Path):
     """Read a result written by :func:`save_result`: a ``SimulationResult``, a
     :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep, a trade study's
-    folder (``TradeResult``) or a flutter envelope saved as JSON (``Envelope``)."""
+    folder (``TradeResult``), a flutter envelope saved as JSON (``Envelope``) or a gust-loads
+    result's JSON (``GustLoadsResult``)."""
     from .flutter_file import FORMAT, open_npz, read_flutter
     from .user_files import user_path
 
@@ -109,6 +110,10 @@ def load_result(path: str | Path):
 
         return load_trade(path)
     if path.suffix.lower() == ".json":
+        from .gust_loads_file import is_gust_loads_file, load_gust_loads
+
+        if is_gust_loads_file(path):
+            return load_gust_loads(path)
         return _load_envelope(path)
     data, meta = open_npz(path)
     fmt = meta.get("format")

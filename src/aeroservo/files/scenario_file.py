@@ -1,7 +1,8 @@
 """Scenario files (``scenarios/*.toml``, schema in ``docs/scenarios.md``).
 
 A scenario says what to run on which wing: an open-loop flutter analysis (``kind =
-"flutter"``), a closed-loop time simulation (``"simulate"``) or a trade study (``"trade"``),
+"flutter"``), a closed-loop time simulation (``"simulate"``), a trade study (``"trade"``) or
+gust loads (``"gust_loads"``, its tables in :mod:`aeroservo.files.gust_loads_tables`),
 with the flight condition, model options, signals, disturbance, a reference to a controller
 file, simulation settings and what to write. :func:`load_scenario` validates everything,
 including the cross-checks that need the wing (signals, sensor stations, controller signals,
@@ -16,6 +17,7 @@ from ..errors import MAX_ELEMENTS, InputError
 from ..simulate.march import MAX_SAMPLES
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
+from .gust_loads_tables import gust_cross_check, gust_loads_tables
 from .scenario_checks import cross_check
 from .scenario_tables import (
     controller,
@@ -43,10 +45,11 @@ TOP = (
     "output",
     "damping",
     "trade",
+    "gust_loads",
 )
 USED = {
     "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping"),
-    "simulate": TOP[:-1],
+    "simulate": TOP[:-2],
     "trade": (
         "scenario",
         "wing",
@@ -57,6 +60,18 @@ USED = {
         "output",
         "damping",
         "trade",
+    ),
+    "gust_loads": (
+        "scenario",
+        "wing",
+        "flight",
+        "model",
+        "signals",
+        "controller",
+        "simulation",
+        "output",
+        "damping",
+        "gust_loads",
     ),
 }
 
@@ -142,7 +157,8 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     fl = top.table("flight").check_keys(
         (), ("density", "altitude", "altitude_ft", "speed", "speed_factor")
     )
-    flight(fl, kw)
+    if fl.data or kind != "gust_loads":  # gust loads: the controller's design point
+        flight(fl, kw)
     if fl.has("speed") and fl.has("speed_factor"):
         fl.fail("speed_factor", fl.data["speed_factor"], "give speed or speed_factor, not both")
     kw["speed"] = fl.number("speed", quantity="flight_speed")
@@ -264,9 +280,11 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         kw["flutter_margin"] = ct.number("flutter_margin", 1.15, lo=1.0, hi=3.0)
     if kind == "trade":
         kw["trade"] = trade_table(top.table("trade", required=True), base)
+    if kind == "gust_loads":
+        gust_loads_tables(top, base, kw)
 
     scenario = Scenario(**kw)
-    cross_check(scenario, top)
+    (gust_cross_check if kind == "gust_loads" else cross_check)(scenario, top)
     return scenario
 
 

@@ -1,5 +1,6 @@
 """Studies: scenarios (:mod:`.scenario`) and their runs (:mod:`.runs`), trade studies over
-design and controller parameters on Dask (:mod:`.trade`).
+design and controller parameters on Dask (:mod:`.trade`), gust loads of CS-25.341 over
+flight points (:mod:`.gust_loads`, :mod:`.gust_run`).
 """
 
 from .._lazy import lazy_attributes
@@ -10,6 +11,10 @@ _PUBLIC = {
     "quick": "scenario",
     "run_scenario": "runs",
     "tuned_gust_loads": "tuned_gusts",
+    "turbulence_response": "turbulence",
+    "FlightPoint": "gust_loads",
+    "GustLoadsStudy": "gust_loads",
+    "run_gust_loads": "gust_run",
 }
 
 __all__ = [
@@ -18,6 +23,10 @@ __all__ = [
     "quick",
     "run_scenario",
     "tuned_gust_loads",
+    "turbulence_response",
+    "FlightPoint",
+    "GustLoadsStudy",
+    "run_gust_loads",
 ]
 
 __getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC)

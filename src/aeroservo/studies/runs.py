@@ -50,6 +50,8 @@ class Run:
         The loop judged over its engaged speed range (controlled loops).
     trade : TradeResult or None
         Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
+    loads : GustLoadsResult or None
+        Gust loads (gust_loads scenarios).
     folder : Path or None
         Folder of a trade study's outputs.
     title : str
@@ -66,6 +68,7 @@ class Run:
     margin_sweep: object = None
     judgement: object = None
     trade: object = None
+    loads: object = None
     folder: Path | None = None
     title: str = ""
 
@@ -316,7 +319,7 @@ def run_scenario(
     progress : bool
         Progress bars on stderr.
     scheduler, workers :
-        Dask scheduler address and local workers of a trade study.
+        Dask scheduler address and local workers of a trade or gust-loads study.
 
     Returns
     -------
@@ -326,6 +329,11 @@ def run_scenario(
         return run_flutter(scenario, progress)
     if scenario.kind == "simulate":
         return run_simulation(scenario, progress)
+    if scenario.kind == "gust_loads":
+        from .gust_scenario import run_gust_scenario
+
+        summary, res = run_gust_scenario(scenario, progress, scheduler, workers)
+        return Run(scenario, summary, loads=res, title=scenario.name)
     from .trade.cluster import run_trade
 
     if out_dir is None:

@@ -1,5 +1,5 @@
-"""A scenario: what to run on which wing (open-loop flutter, closed-loop simulation, trade study),
-with the flight condition, model options, signals, disturbance, controller and outputs.
+"""A scenario: what to run on which wing (open-loop flutter, closed-loop simulation, trade study,
+gust loads), with the flight condition, model options, signals, disturbance, controller and outputs.
 Read from a scenario file by :mod:`aeroservo.files.scenario_file`; run by
 :mod:`aeroservo.studies.runs`.
 """
@@ -14,7 +14,7 @@ from ..system.damping import NO_DAMPING, StructuralDamping
 __all__ = ["Scenario", "Disturbance", "quick", "SCENARIO_KINDS"]
 
 
-SCENARIO_KINDS = ("flutter", "simulate", "trade")
+SCENARIO_KINDS = ("flutter", "simulate", "trade", "gust_loads")
 GUST_TYPES = ("none", "one_minus_cosine", "turbulence", "series")
 GUST_KEYS = {
     "none": (),
@@ -42,7 +42,13 @@ class Disturbance:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario (SI units). See ``docs/scenarios.md`` for every key."""
+    """A validated scenario (SI units). See ``docs/scenarios.md`` for every key.
+
+    ``trade`` holds a trade study's table and ``gust_loads`` a gust-loads study's (a dict:
+    ``loads``, ``points`` (:class:`~aeroservo.studies.gust_loads.FlightPoint`), ``mass_cases``
+    (name -> wing, the first the default), ``design_mass_case``, ``n_gradients``,
+    ``turbulence``, ``workers``, ``f_g`` or ``weights``); None for the other kinds.
+    """
 
     name: str
     kind: str
@@ -85,6 +91,7 @@ class Scenario:
     result: str = ""
     plots: bool = True
     trade: object = None
+    gust_loads: object = None
 
     def model(self):
         """The aeroelastic model of the scenario's wing and options."""
@@ -145,7 +152,7 @@ class Scenario:
 def quick(s: Scenario) -> Scenario:
     """Fast settings of a scenario for smoke tests: at most 0.5 s simulated, an 11-point
     closed-loop grid, 3 margin speeds, two values per trade parameter and a 0.3 s gust in
-    trade studies."""
+    trade studies; gust loads at the first two flight points with at most 5 gust gradients."""
     from dataclasses import replace
 
     kw: dict = {
@@ -160,4 +167,9 @@ def quick(s: Scenario) -> Scenario:
         t["gust_duration"] = min(t["gust_duration"], 0.3)
         t["n_grid"] = min(t["n_grid"], 11)
         kw["trade"] = t
+    if s.gust_loads is not None:
+        g = dict(s.gust_loads)
+        g["points"] = tuple(g["points"][:2])
+        g["n_gradients"] = min(g["n_gradients"], 5)
+        kw["gust_loads"] = g
     return replace(s, **kw)

@@ -1,4 +1,4 @@
-"""Discrete tuned gusts of CS-25.341(a) on a linear state-space model (open loop).
+"""Discrete tuned gusts of CS-25.341(a) on a linear state-space model, open or closed loop.
 
 The gust is ``U(t) = U_ds/2 (1 - cos(pi V t / H))`` for ``0 <= V t <= 2 H`` (V the true
 airspeed of the model, ``U_ds`` the rule's design velocity turned into a true one,
@@ -7,32 +7,32 @@ positive up, uniform along the span; t = 0 when the gust front reaches the leadi
 reference of the Kussner function; ``docs/statespace.md``). Loads are incremental (no 1 g
 load).
 
-Time march: exact discretization of ``x' = A x + B u`` for an input linear between samples
-(first-order hold, by the matrix exponential of the augmented matrix, Van Loan 1978). It is
-exact for every mode whatever its frequency (no stability limit), so the step only has to
-resolve the input and the extremes: ``dt = (2 H_min / V) / steps_per_gust`` for every gradient
-of the search (one exponential), and each extreme is refined by the parabola through its three
-samples. The march covers the gust and ``settle_periods`` periods ``2 pi / |lambda|_min`` of the
-slowest pole after it.
+Marches (:mod:`aeroservo.studies.gust_march`): open loop, the exact first-order-hold
+discretization with ``dt = (2 H_min / V) / steps_per_gust`` for every gradient; with a
+controller, the sampled loop of :func:`aeroservo.simulate.simulate` at the controller's rate,
+with its actuator limits. Each extreme is refined by the parabola through its three samples.
+The march covers the gust and ``settle_periods`` periods ``2 pi / |lambda|_min`` of the slowest
+open-loop pole after it.
 
-Tuning: the peak of each load over time is computed on ``n_gradients`` log-spaced gradients H;
-each load's maximum and minimum are then refined by a bounded scalar search between the grid
-neighbours of the best grid value. The model is linear: the negative gust gives the mirrored
-response, so each load's maximum is ``max(max y+, -min y+)`` and its minimum the opposite.
+Tuning: the peak of each load over time is computed on ``n_gradients`` log-spaced gradients H
+and both gust signs; each load's maximum and minimum are then refined by a bounded scalar
+search between the grid neighbours of the best grid value. Open loop the model is linear: the
+negative gust gives the mirrored response, so only the positive gust is marched. A closed loop
+with actuator limits is not linear: both signs are marched.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import minimize_scalar
 
 from ..aero.atmosphere import isa
 from ..aero.gust_rules import GRADIENT_RANGE, design_gust_velocity, gust_tas
 from ..errors import InputError, check_int, check_number
+from .gust_march import ExactGustMarch, LoopGustMarch, one_minus_cosine_response, peak
 
 __all__ = ["GustExtreme", "TunedGustResult", "one_minus_cosine_response", "tuned_gust_loads"]
 
@@ -53,6 +53,8 @@ class GustExtreme:
         Time [s] of each after the gust front reaches the wing.
     max_sign, min_sign : int
         Gust sign giving each (+1 up, -1 down).
+    max_correlated, min_correlated : dict
+        Every load at the time of the extreme (the correlated loads), by name [their units].
     """
 
     load: str
@@ -65,6 +67,21 @@ class GustExtreme:
     min_gradient: float
     min_time: float
     min_sign: int
+    max_correlated: dict = field(default_factory=dict)
+    min_correlated: dict = field(default_factory=dict)
+
+    def side(self, which: str) -> tuple[float, float, float, int, dict]:
+        """``(value, gradient, time, sign, correlated)`` of ``"max"`` or ``"min"``."""
+        if which not in ("max", "min"):
+            raise InputError(f"side = {which!r}: expected 'max' or 'min'")
+        p = which + "_"
+        return (
+            self.maximum if which == "max" else self.minimum,
+            getattr(self, p + "gradient"),
+            getattr(self, p + "time"),
+            getattr(self, p + "sign"),
+            getattr(self, p + "correlated"),
+        )
 
 
 @dataclass(frozen=True)
@@ -86,7 +103,21 @@ class TunedGustResult:
     extremes : dict
         Load name -> :class:`GustExtreme` (refined).
     dt : float
-        Time step of the march [s].
+        Time step of the march [s] (the controller's sample period in a closed loop).
+    controller : str
+        ``"open loop"`` or the controller's name.
+    peaks_negative : ndarray or None
+        As ``peaks`` for the negative gust (closed loop; None open loop: the mirror image).
+    limited : dict
+        Closed loop: control -> (n_gradients, 2) largest share of samples at a magnitude or
+        rate limit, for the positive and negative gust (empty open loop).
+    histories : dict
+        ``(H, sign)`` -> ``(t, gust, y)`` of the critical gusts: times [s], gust velocity
+        [m/s true], outputs (n_t, n_loads) in the order of ``loads``.
+    loads : tuple of str
+        Output names, in the order of the arrays.
+    units : dict
+        Units by load.
     """
 
     speed: float
@@ -96,88 +127,64 @@ class TunedGustResult:
     peaks: np.ndarray
     extremes: dict
     dt: float
+    controller: str = "open loop"
+    peaks_negative: np.ndarray | None = None
+    limited: dict = field(default_factory=dict)
+    histories: dict = field(default_factory=dict)
+    loads: tuple = ()
+    units: dict = field(default_factory=dict)
+
+    @property
+    def saturated(self) -> bool:
+        """True if a control reached a magnitude or rate limit in any gust of the search."""
+        return any(float(np.max(a)) > 0 for a in self.limited.values())
+
+    def history(self, load: str, side: str = "max") -> tuple[np.ndarray, np.ndarray, dict]:
+        """Time history of the gust critical for ``load``'s ``side`` (``"max"``/``"min"``):
+        ``(t [s], gust [m/s true], {load: values})``."""
+        if load not in self.extremes:
+            raise InputError(f"load {load!r}: not in the result ({list(self.extremes)})")
+        _, h, _, sign, _ = self.extremes[load].side(side)
+        t, gust, y = self.histories[(h, sign)]
+        return t, gust, {n: y[:, i] for i, n in enumerate(self.loads)}
 
 
-class _March:
-    """First-order-hold exact march of one input of a state-space model."""
-
-    def __init__(self, sys, dt: float):
-        names = list(sys.input_labels)
-        if "gust" not in names:
-            raise InputError(f"model inputs {names}: a 'gust' input is needed")
-        j = names.index("gust")
-        A = np.asarray(sys.A, dtype=float)
-        n = A.shape[0]
-        self.B = np.asarray(sys.B, dtype=float)[:, j]
-        self.C = np.asarray(sys.C, dtype=float)
-        self.D = np.asarray(sys.D, dtype=float)[:, j]
-        M = np.zeros((n + 2, n + 2))
-        M[:n, :n] = A * dt
-        M[:n, n] = self.B * dt
-        M[n, n + 1] = 1.0
-        E = sla.expm(M)
-        # x1 = Phi x0 + G0 u0 + G1 (u1 - u0), G0 = int_0^dt e^{A s} ds B,
-        # G1 = int_0^dt e^{A s} (1 - s/dt) ds B
-        self.Phi, self.G0, self.G1 = E[:n, :n], E[:n, n], E[:n, n + 1]
-        self.dt = dt
-
-    def run(self, u: np.ndarray) -> np.ndarray:
-        """Outputs (n_samples, n_outputs) for the input samples ``u`` from rest."""
-        du = np.diff(u)
-        f = np.outer(u[:-1], self.G0) + np.outer(du, self.G1)
-        x = np.zeros((u.size, self.Phi.shape[0]))
-        PhiT = self.Phi.T
-        for k in range(u.size - 1):
-            x[k + 1] = x[k] @ PhiT + f[k]
-        return x @ self.C.T + np.outer(u, self.D)
+def _check_model(sys, altitude: float) -> tuple[float, float]:
+    speed = check_number("sys.speed", getattr(sys, "speed", None), unit="m/s", lo=0.0, lo_open=True)
+    alt = check_number("altitude", altitude, unit="m", lo=0.0)
+    rho = isa(alt).density
+    dens = getattr(sys, "density", rho)
+    if abs(dens - rho) > 1e-3 * rho:
+        raise InputError(
+            f"model density {dens} kg/m^3 is not the ISA density {rho:.4f} kg/m^3 at {alt} m"
+        )
+    return speed, alt
 
 
-def _profile(t: np.ndarray, speed: float, gradient: float) -> np.ndarray:
-    s = speed * t
-    return np.where(s <= 2 * gradient, 0.5 * (1 - np.cos(np.pi * s / gradient)), 0.0)
+def _check_stable(sys, speed: float, controller, delay: bool, sample_rate) -> None:
+    """Refuse an unstable open loop, or a linear closed loop that is unstable."""
+    if controller is None:
+        ev = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
+        if ev.real.max() >= 0:
+            raise InputError(
+                f"model at {speed} m/s has an unstable or neutral pole "
+                f"{ev[np.argmax(ev.real)]:.4g}: open-loop gust loads need a stable model "
+                "(below the flutter speed)"
+            )
+        return
+    from ..design.interface import as_controller, has_linear_law
 
+    if not has_linear_law(as_controller(controller, sample_rate=sample_rate)):
+        return  # a nonlinear law: judged by its march only
+    from ..design.closed_loop import closed_loop_matrix
 
-def _peak(y: np.ndarray, dt: float, sign: int) -> tuple[float, float]:
-    """Extreme (sign +1 max, -1 min) of samples ``y`` and its time, refined by a parabola."""
-    k = int(np.argmax(sign * y))
-    if 0 < k < y.size - 1:
-        ym, y0, yp = sign * y[k - 1 : k + 2]
-        den = ym - 2 * y0 + yp
-        if den < 0:
-            d = 0.5 * (ym - yp) / den
-            return sign * (y0 - 0.25 * (ym - yp) * d), (k + d) * dt
-    return float(y[k]), k * dt
-
-
-def one_minus_cosine_response(
-    sys, gradient: float, amplitude: float, duration: float, dt: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Response of every output to one 1-cos gust (``U(t) = amplitude/2 (1 - cos(pi V t/H))``).
-
-    Parameters
-    ----------
-    sys : control.StateSpace
-        Model with a ``gust`` input [m/s] and ``sys.speed`` [m/s] (true airspeed).
-    gradient : float
-        Gust gradient H [m] (half the gust length).
-    amplitude : float
-        U_ds [m/s true], signed.
-    duration, dt : float
-        Length and step of the march [s].
-
-    Returns
-    -------
-    t : ndarray
-        Times [s].
-    y : ndarray
-        (n_times, n_outputs) outputs in their units.
-    """
-    gradient = check_number("gust gradient H", gradient, unit="m", lo=0.0, lo_open=True)
-    amplitude = check_number("gust amplitude", amplitude, unit="m/s")
-    dt = check_number("dt", dt, unit="s", lo=0.0, lo_open=True)
-    duration = check_number("duration", duration, unit="s", lo=dt)
-    t = np.arange(int(np.ceil(duration / dt)) + 1) * dt
-    return t, _March(sys, dt).run(amplitude * _profile(t, float(sys.speed), gradient))
+    A, dt = closed_loop_matrix(sys, controller, delay=delay, sample_rate=sample_rate)
+    radius = float(np.max(np.abs(np.linalg.eigvals(A))))
+    if radius >= 1.0:
+        raise InputError(
+            f"closed loop at {speed:.4g} m/s TAS is unstable (spectral radius {radius:.6g} of the "
+            "sampled loop): gust loads need a stable loop"
+        )
 
 
 def tuned_gust_loads(
@@ -186,20 +193,25 @@ def tuned_gust_loads(
     f_g: float = 1.0,
     *,
     at_vd: bool = False,
+    controller=None,
+    limits=None,
+    delay: bool = False,
+    sample_rate: float | None = None,
     n_gradients: int = 20,
     refine: bool = True,
     steps_per_gust: int = 200,
     settle_periods: float = 2.0,
     amplitude: Callable[[float], float] | None = None,
 ) -> TunedGustResult:
-    """Tuned discrete-gust search of CS-25.341(a), open loop, on every output of ``sys``.
+    """Tuned discrete-gust search of CS-25.341(a) on every output of ``sys``.
 
     Parameters
     ----------
     sys : control.StateSpace
-        Stable model (``aeroservo.statespace``) with a ``gust`` input, at the ISA density of
-        ``altitude``; its outputs are the loads (e.g. ``root_shear``, ``root_bending_moment``,
-        ``root_torque``, ``tip_le_accel``, hinge moments, sensors).
+        Model (``aeroservo.statespace`` or ``ControlLoop.plant``) with a ``gust`` input, at the
+        ISA density of ``altitude``; its outputs are the loads (e.g. ``root_shear``,
+        ``root_bending_moment``, ``root_torque``, ``tip_le_accel``, hinge moments, sensors).
+        Open loop it must be stable (below flutter).
     altitude : float
         Altitude [m] (U_ref and the EAS-to-TAS conversion).
     f_g : float
@@ -207,12 +219,22 @@ def tuned_gust_loads(
         (:func:`aeroservo.aero.gust_rules.flight_profile_alleviation`).
     at_vd : bool
         Half U_ref (design dive speed).
+    controller : optional
+        Any controller of :func:`aeroservo.design.as_controller` (a linear one must give a
+        stable sampled loop); None for the open loop. The controls applied are added to the
+        loads (e.g. the actuator's hinge moment).
+    limits : aeroservo.design.Limits, optional
+        Actuator limits of the closed loop (their saturation is reported in ``limited``).
+    delay : bool
+        One-sample computational delay of the closed loop.
+    sample_rate : float, optional
+        [Hz] for a continuous python-control compensator.
     n_gradients : int
         Log-spaced gradients H from 30 ft to 350 ft scanned before refinement.
     refine : bool
         Refine each load's maximum and minimum by a bounded scalar search in H.
     steps_per_gust : int
-        Time steps per duration of the shortest gust (2 x 30 ft / V).
+        Open loop: time steps per duration of the shortest gust (2 x 30 ft / V).
     settle_periods : float
         March length after the gust, in periods ``2 pi / |lambda|_min`` of the slowest pole.
     amplitude : callable, optional
@@ -222,14 +244,7 @@ def tuned_gust_loads(
     -------
     TunedGustResult
     """
-    speed = check_number("sys.speed", getattr(sys, "speed", None), unit="m/s", lo=0.0, lo_open=True)
-    alt = check_number("altitude", altitude, unit="m", lo=0.0)
-    rho = isa(alt).density
-    dens = getattr(sys, "density", rho)
-    if abs(dens - rho) > 1e-3 * rho:
-        raise InputError(
-            f"model density {dens} kg/m^3 is not the ISA density {rho:.4f} kg/m^3 at {alt} m"
-        )
+    speed, alt = _check_model(sys, altitude)
     n_g = check_int("n_gradients", n_gradients, lo=3)
     n_step = check_int("steps_per_gust", steps_per_gust, lo=10)
     settle = check_number("settle_periods", settle_periods, lo=0.0)
@@ -238,60 +253,115 @@ def tuned_gust_loads(
         def amplitude(h: float) -> float:
             return gust_tas(design_gust_velocity(h, alt, f_g, at_vd=at_vd), alt)
 
-    ev = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
-    if ev.real.max() >= 0:
-        raise InputError(
-            f"model at {speed} m/s has an unstable or neutral pole {ev[np.argmax(ev.real)]:.4g}:"
-            " open-loop gust loads need a stable model (below the flutter speed)"
-        )
+    _check_stable(sys, speed, controller, delay, sample_rate)
     h_lo, h_hi = GRADIENT_RANGE
-    dt = 2 * h_lo / speed / n_step
-    march = _March(sys, dt)
+    if controller is None:
+        march = ExactGustMarch(sys, 2 * h_lo / speed / n_step)
+        label, signs = "open loop", (1,)
+    else:
+        march = LoopGustMarch(sys, controller, limits, delay, sample_rate)
+        label = getattr(march.controller, "name", None) or type(march.controller).__name__
+        signs = (1, -1)
+    dt = march.dt
+    ev = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
     tail = settle * 2 * np.pi / np.abs(ev).min()
-    names = list(sys.output_labels)
-    units = getattr(sys, "signal_units", {})
-    cache: dict[float, tuple] = {}
+    names = list(march.outputs)
+    held = {names.index(c) for c in getattr(march, "controls", ())}  # zero-order hold: no parabola
+    units = dict(getattr(sys, "signal_units", {}))
+    cache: dict[tuple, tuple] = {}
 
-    def peaks(h: float) -> tuple:
-        if h not in cache:
-            t = np.arange(int(np.ceil((2 * h / speed + tail) / dt)) + 1) * dt
-            u = amplitude(h)
-            y = march.run(u * _profile(t, speed, h))
-            cache[h] = tuple(
-                (_peak(y[:, i], dt, 1), _peak(y[:, i], dt, -1)) for i in range(y.shape[1])
+    def run(h: float, sign: int):
+        """Peaks ((max, t), (min, t)) per load of the gust (h, sign), its limits and arrays."""
+        key = (h, sign)
+        if key not in cache:
+            t, y, lim = march.response(h, sign * amplitude(h), 2 * h / speed + tail)
+            pk = tuple(
+                (peak(y[:, i], dt, 1, i not in held), peak(y[:, i], dt, -1, i not in held))
+                for i in range(y.shape[1])
             )
-        return cache[h]
+            cache[key] = (pk, lim, t, y)
+        return cache[key]
+
+    def signed(h: float, sign: int) -> tuple[np.ndarray, np.ndarray]:
+        """Times and outputs of the gust (h, sign); open loop the mirror of the positive one."""
+        if len(signs) == 1:
+            _, _, t, y = run(h, 1)
+            return t, sign * y
+        _, _, t, y = run(h, sign)
+        return t, y
 
     grid = np.geomspace(h_lo, h_hi, n_g)
-    table = np.array([[[p[0][0], p[1][0]] for p in peaks(h)] for h in grid])
+    tables = {
+        s: np.array([[[p[0][0], p[1][0]] for p in run(h, s)[0]] for h in grid]) for s in signs
+    }
     extremes = {}
     for i, name in enumerate(names):
-        best = []
-        for side, sgn in ((0, 1.0), (1, -1.0)):  # positive-gust max, positive-gust min
-            k = int(np.argmax(sgn * table[:, i, side]))
-            h_best = grid[k]
-            if refine:
-                lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, n_g - 1)]
-                res = minimize_scalar(
-                    lambda lh, i=i, side=side, sgn=sgn: -sgn * peaks(float(np.exp(lh)))[i][side][0],
-                    bounds=(np.log(lo), np.log(hi)),
-                    method="bounded",
-                    options={"xatol": 1e-4},
-                )
-                h_try = float(np.exp(res.x))
-                if sgn * peaks(h_try)[i][side][0] > sgn * peaks(h_best)[i][side][0]:
-                    h_best = h_try
-            val, t_at = peaks(h_best)[i][side]
-            best.append((val, h_best, t_at))
-        (pmax, hmax, tmax), (pmin, hmin, tmin) = best
-        # negative gust mirrors: its max is -pmin, its min is -pmax
-        if pmax >= -pmin:
-            mx = (pmax, hmax, tmax, 1)
-            mn = (-pmax, hmax, tmax, -1)
-        else:
-            mx = (-pmin, hmin, tmin, -1)
-            mn = (pmin, hmin, tmin, 1)
-        mx, mn = (tuple(float(v) for v in e[:3]) + (e[3],) for e in (mx, mn))
-        extremes[name] = GustExtreme(name, units.get(name, ""), *mx, *mn)
+        found = {}
+        for side, sgn in ((0, 1.0), (1, -1.0)):  # max, min
+            cands = []
+            for s in signs:
+                k = int(np.argmax(sgn * tables[s][:, i, side]))
+                h_best = grid[k]
+                if refine:
+                    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, n_g - 1)]
+                    res = minimize_scalar(
+                        lambda lh, i=i, side=side, sgn=sgn, s=s: (
+                            -sgn * run(float(np.exp(lh)), s)[0][i][side][0]
+                        ),
+                        bounds=(np.log(lo), np.log(hi)),
+                        method="bounded",
+                        options={"xatol": 1e-3},
+                    )
+                    h_try = float(np.exp(res.x))
+                    if sgn * run(h_try, s)[0][i][side][0] > sgn * run(h_best, s)[0][i][side][0]:
+                        h_best = h_try
+                val, t_at = run(h_best, s)[0][i][side]
+                cands.append((sgn * val, float(val), float(h_best), float(t_at), s))
+            found[side] = max(cands)[1:]
+        if len(signs) == 1:  # the negative gust mirrors: its max is -min, its min is -max
+            (pmax, hmax, tmax, _), (pmin, hmin, tmin, _) = found[0], found[1]
+            if pmax >= -pmin:
+                found = {0: (pmax, hmax, tmax, 1), 1: (-pmax, hmax, tmax, -1)}
+            else:
+                found = {0: (-pmin, hmin, tmin, -1), 1: (pmin, hmin, tmin, 1)}
+        corr = []
+        for side in (0, 1):
+            _, h, t_at, sign = found[side]
+            t, y = signed(h, sign)
+            corr.append({n: float(np.interp(t_at, t, y[:, j])) for j, n in enumerate(names)})
+        extremes[name] = GustExtreme(
+            name, units.get(name, ""), *found[0], *found[1], corr[0], corr[1]
+        )
+    histories = {}
+    for e in extremes.values():
+        for side in ("max", "min"):
+            _, h, _, sign, _ = e.side(side)
+            t, y = signed(h, sign)
+            histories[(h, sign)] = (t, sign * amplitude(h) * _gust_at(t, speed, h, march), y)
+    limited = {}
+    for c in getattr(march, "controls", ()):
+        limited[c] = np.array([[max(run(h, s)[1][c]) for s in signs] for h in grid])
     amps = np.array([amplitude(h) for h in grid])
-    return TunedGustResult(speed, alt, grid, amps, table, extremes, dt)
+    return TunedGustResult(
+        speed,
+        alt,
+        grid,
+        amps,
+        tables[1],
+        extremes,
+        dt,
+        controller=label,
+        peaks_negative=tables.get(-1),
+        limited=limited,
+        histories=histories,
+        loads=tuple(names),
+        units={n: units.get(n, "") for n in names},
+    )
+
+
+def _gust_at(t: np.ndarray, speed: float, h: float, march) -> np.ndarray:
+    """The unit gust as the march applied it (the midpoint of each sample in a sampled loop)."""
+    from .gust_march import profile
+
+    shift = 0.5 * march.dt if isinstance(march, LoopGustMarch) else 0.0
+    return profile(t + shift, speed, h)

@@ -18,11 +18,16 @@ ends include the damped frequencies of the poles +- multiples of their decay rat
 resonance peak is resolved), from 0 to ``omega_hi = 1000 x`` the spectral radius of A; beyond
 it the spectrum is its power-law asymptote ``c omega^-p`` and ``|H|^2`` its expansion in the
 Markov parameters ``C A^k B`` (``|H|^2 = D^2 + (m0^2 - 2 D m1)/omega^2 + ...``), integrated in
-closed form. An output with a direct feedthrough from the gust (``D != 0``) has an infinite
-``N0`` for any spectrum decaying like ``omega^-p`` with ``p <= 3`` (von Karman: 5/3): it is
-returned as ``inf``. ``N0`` of accelerations and root loads counts every structural mode of the
-model up to the highest finite-element frequency: the strip model's high modes are not physical,
-so it depends on the mesh.
+closed form; the cross terms ``Re(H_i conj H_j)`` give the covariance of the loads (turbulence
+ellipses of correlated loads). An output with a direct feedthrough from the gust (``D != 0``)
+has an infinite ``N0`` for any spectrum decaying like ``omega^-p`` with ``p <= 3`` (von
+Karman: 5/3): it is returned as ``inf``. ``N0`` of accelerations and root loads counts every
+structural mode of the model up to the highest finite-element frequency: the strip model's high
+modes are not physical, so it depends on the mesh.
+
+With a sampled linear controller ``H`` is the response at the sample instants of the loop the
+simulator marches, ``H_s`` (:mod:`.turbulence_loop`): ``A_bar^2`` is the exact variance of the
+sampled outputs, ``N0`` the zero-crossing rate of a stationary process with their spectrum.
 """
 
 from __future__ import annotations
@@ -34,6 +39,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, check_number
+from .turbulence_loop import (
+    ModalResponse,
+    SampledResponse,
+    adaptive,
+    alias_start,
+    breakpoints,
+    columns,
+    diagonal,
+    loop_moments,
+    markov_tail,
+    outer,
+    pack,
+    unpack,
+)
 
 __all__ = [
     "Spectrum",
@@ -125,12 +144,14 @@ def u_sigma(altitude: float, f_g: float = 1.0, *, at_vd: bool = False) -> float:
 
 @dataclass
 class TurbulenceResult:
-    """RMS per unit gust RMS and zero-crossing rates of each output.
+    """RMS per unit gust RMS, zero-crossing rates and covariances of outputs.
 
     ``a_bar[name]`` [output unit per m/s], ``n0[name]`` [1/s] (``inf`` with a gust
     feedthrough), ``units[name]``, ``speed`` [m/s], ``spectrum`` name, ``omega_hi`` [rad/s]
     the start of the analytic tail and ``tail_fraction[name]`` the share of ``A_bar^2`` it
-    carries.
+    carries; ``covariance`` (n, n) per unit gust variance in the order of ``outputs`` (its
+    diagonal is ``A_bar^2``); ``controller`` the loop's label (``"open loop"``) and
+    ``sample_rate`` [Hz] (None in open loop: the continuous response).
     """
 
     a_bar: dict[str, float]
@@ -140,104 +161,77 @@ class TurbulenceResult:
     spectrum: str
     omega_hi: float
     tail_fraction: dict[str, float] = field(default_factory=dict)
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    outputs: tuple = ()
+    controller: str = "open loop"
+    sample_rate: float | None = None
 
     def design_loads(self, u_sigma_value: float) -> dict[str, float]:
         """``U_sigma A_bar`` per output [output unit], ``u_sigma_value`` [m/s TAS]."""
         check_number("u_sigma", u_sigma_value, unit="m/s", lo=0.0)
         return {k: u_sigma_value * v for k, v in self.a_bar.items()}
 
-
-# -- frequency response ------------------------------------------------------------------------
-
-
-class _Response:
-    """``H(j omega)`` of selected outputs to one input, by the eigendecomposition of A (checked
-    against a direct solve; a direct solve per frequency when the check fails)."""
-
-    def __init__(self, a, b, c, d):
-        self.a, self.b, self.c, self.d = a, b, c, d
-        self.lam, vecs = np.linalg.eig(a)
-        self.bt = np.linalg.solve(vecs, b)
-        self.ct = c @ vecs
-        probe = np.unique(np.abs(self.lam.imag[self.lam.imag > 0]))[:20]
-        probe = np.concatenate([probe, [1.0, float(np.max(np.abs(self.lam)))]])
-        ref = np.array([self._direct(w) for w in probe])
-        got = self._modal(probe)
-        scale = np.max(np.abs(ref), axis=0) + 1e-300
-        self.modal_ok = bool(np.all(np.abs(got - ref) <= 1e-8 * scale))
-
-    def _direct(self, w: float) -> np.ndarray:
-        n = self.a.shape[0]
-        return self.c @ np.linalg.solve(1j * w * np.eye(n) - self.a, self.b) + self.d
-
-    def _modal(self, w: np.ndarray) -> np.ndarray:
-        r = self.bt[None, :] / (1j * w[:, None] - self.lam[None, :])
-        return r @ self.ct.T + self.d[None, :]
-
-    def __call__(self, w: np.ndarray) -> np.ndarray:
-        if self.modal_ok:
-            return self._modal(w)
-        return np.array([self._direct(x) for x in w]).reshape(w.size, -1)
+    def correlation(self, a: str, b: str) -> float:
+        """Correlation coefficient of outputs ``a`` and ``b`` (in [-1, 1]; the turbulence
+        ellipse of two loads is ``(x/A_a)^2 - 2 rho x y/(A_a A_b) + (y/A_b)^2 = 1 - rho^2``)."""
+        idx = []
+        for n in (a, b):
+            if n not in self.outputs:
+                raise InputError(f"output {n!r}: not in the result ({list(self.outputs)})")
+            idx.append(self.outputs.index(n))
+        i, j = idx
+        c = self.covariance
+        den = math.sqrt(c[i, i] * c[j, j])
+        return float(np.clip(c[i, j] / den, -1.0, 1.0)) if den > 0 else 0.0
 
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
-
-
-def _panel_integrals(resp, psd, lo: np.ndarray, hi: np.ndarray, log: np.ndarray):
-    """Gauss-Legendre integrals of ``|H|^2 Phi_t`` and ``omega^2 |H|^2 Phi_t`` on panels.
-
-    Returns two arrays (panels, outputs). ``log`` panels integrate in ``ln omega``.
-    """
-    a = np.where(log, np.log(np.where(log, lo, 1.0)), lo)
-    b = np.where(log, np.log(np.where(log, hi, 1.0)), hi)
-    mid, half = (a + b) / 2, (b - a) / 2
-    u = mid[:, None] + half[:, None] * _GL_X[None, :]
-    w = np.where(log[:, None], np.exp(u), u)
-    jac = half[:, None] * _GL_W[None, :] * np.where(log[:, None], w, 1.0)
-    flat = w.ravel()
-    h2 = np.abs(resp(flat)) ** 2  # (m, outputs)
-    f = h2 * psd(flat)[:, None]
-    f = f.reshape(w.shape + (h2.shape[1],)) * jac[..., None]
-    m0 = f.sum(axis=1)
-    m2 = (f * (w**2)[..., None]).sum(axis=1)
-    return m0, m2
-
-
-def _breakpoints(lam: np.ndarray, speed: float, scale: float, w_hi: float) -> np.ndarray:
-    w_lo = 1e-4 * min(speed / (1.339 * scale), np.min(np.abs(lam)))
-    decades = math.log10(w_hi / w_lo)
-    pts = [np.logspace(math.log10(w_lo), math.log10(w_hi), int(8 * decades) + 1)]
-    osc = lam[lam.imag > 0]
-    k = np.array([-16, -8, -4, -2, -1, -0.5, 0, 0.5, 1, 2, 4, 8, 16])
-    for z in osc:
-        pts.append(z.imag + k * abs(z.real))
-    p = np.concatenate(pts)
-    p = np.unique(np.concatenate([p[(p > w_lo) & (p < w_hi)], [w_lo, w_hi]]))
-    return np.concatenate([[0.0], p])  # ends exactly at w_hi, where the closed-form tail starts
-
-
-def _tail(resp: _Response, spec: Spectrum, speed: float, w_hi: float):
-    """Closed-form integrals beyond ``w_hi``: Markov expansion of |H|^2 times ``K w^-p``."""
-    a, b, c, d = resp.a, resp.b, resp.c, resp.d
-    m, v = [], b.copy()
-    for _ in range(4):
-        m.append(c @ v)
-        v = a @ v
-    m0, m1, m2, m3 = m
-    coef = [d**2, m0**2 - 2 * d * m1, m1**2 + 2 * d * m3 - 2 * m0 * m2]  # of w^0, w^-2, w^-4
+def _open_moments(
+    resp: ModalResponse, spec: Spectrum, v: float, scale: float, w_hi: float, rtol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance and second-moment columns of the continuous response, and of their tail."""
+    ny = resp.ct.shape[0]
     p = spec.tail_exponent
-    k_t = spec.tail_coefficient * speed ** (p - 1.0)  # Phi_t ~ k_t w^-p
-    t0 = np.zeros_like(d, dtype=float)
-    t2 = np.zeros_like(d, dtype=float)
-    for j, cj in enumerate(coef):
-        e0 = p + 2 * j - 1.0  # int_w_hi^inf w^-(p+2j) = w_hi^-e0 / e0
-        t0 = t0 + cj * k_t * w_hi ** (-e0) / e0
-        e2 = p + 2 * j - 3.0
-        if e2 > 0:
-            t2 = t2 + cj * k_t * w_hi ** (-e2) / e2
-        else:
-            t2 = np.where(np.abs(cj) > 0, np.inf, t2)
-    return t0, t2
+    tail = pack(*markov_tail(resp.markov(5), ny, spec.tail_coefficient * v ** (p - 1), p, w_hi))
+
+    def f(w):
+        return columns(outer(resp(w)), w, spec.time_psd(w, v))
+
+    pts = breakpoints(resp.lam, v, scale, w_hi)
+    done = adaptive(f, pts, rtol, diagonal(ny), np.where(np.isfinite(tail), tail, 0.0))
+    return done + tail, tail
+
+
+def _sampled_loop(sys, controller, delay: bool, sample_rate, rows: list, iw: int, v: float):
+    """``(SampledResponse, closed-loop eigenvalues, label, rate)``, or None for an open loop."""
+    from ..design.closed_loop import linear_controller
+    from ..design.interface import controller_at
+    from ..design.law import delayed
+    from ..design.plant import SampledPlant
+    from ..design.sampled_loop import LoopBlocks, linear_law, plant_states
+
+    if not isinstance(delay, (bool, np.bool_)):
+        raise InputError(f"delay = {delay!r}: expected True or False")
+    ctrl = linear_controller(controller, "turbulence_response", sample_rate)
+    ctrl = controller_at(ctrl, float(getattr(sys, "speed", v)))
+    law = linear_law(ctrl, plant_states(sys))
+    if law.kind == "open":
+        return None
+    law = delayed(law) if delay else law
+    label = (law.source or type(ctrl).__name__) + (", one-sample delay" if delay else "")
+    arrays = tuple(np.asarray(x, dtype=float) for x in (sys.A, sys.B, sys.C, sys.D))
+    labels = (list(sys.input_labels), list(sys.output_labels))
+    sp = SampledPlant.from_arrays(arrays, labels, law.dt, law.controls, (), law.sensors)
+    zeta = np.linalg.eigvals(LoopBlocks(sp, law).closed())
+    radius = float(np.max(np.abs(zeta)))
+    if radius >= 1.0:
+        raise InputError(
+            f"speed = {v:g} m/s: the sampled loop with {label} is unstable (spectral radius "
+            f"{radius:.6g} >= 1); turbulence RMS is defined for stable loops only"
+        )
+    iu = [labels[0].index(c) for c in law.controls]
+    srows = None if law.state_feedback else [labels[1].index(s) for s in law.sensors]
+    resp = SampledResponse(*arrays, iu, iw, rows, srows, law, sp.Phi, sp.Gu)
+    return resp, zeta, label, 1.0 / law.dt
 
 
 def turbulence_response(
@@ -249,13 +243,25 @@ def turbulence_response(
     gust_input: str = "gust",
     rtol: float = 1e-9,
     omega_hi: float | None = None,
+    controller=None,
+    delay: bool = False,
+    sample_rate: float | None = None,
 ) -> TurbulenceResult:
-    """A_bar and N0 of outputs of a linear model under continuous turbulence.
+    """A_bar, N0 and covariances of outputs of a linear model under continuous turbulence.
+
+    Open loop, the continuous response ``H(j omega)``; with a linear ``controller``, the
+    stationary response at the sample instants of the loop :func:`aeroservo.simulate.simulate`
+    marches (zero-order hold on the commands, the plant exact between samples, limits
+    inactive), ``H_s(omega)`` of :mod:`.turbulence_loop`: ``A_bar^2 = int |H_s|^2 Phi_t`` is
+    then the exact variance of the sampled outputs (the integral over every omega folds the
+    aliases) and ``N0 = (1/2pi) sqrt(int omega^2 |H_s|^2 Phi_t / A_bar^2)`` the zero-crossing
+    rate of the stationary process with the spectrum of the sampled response.
 
     Parameters
     ----------
     sys : control.StateSpace
-        Stable model from :func:`aeroservo.statespace` with a gust input [m/s].
+        Model from :func:`aeroservo.statespace` with a gust input [m/s] (and the controller's
+        controls and sensors); stable, or stable in closed loop with a controller.
     outputs : list of str, optional
         Output names (default: root shear, bending moment, torque and the tip accelerations
         present in ``sys``).
@@ -269,11 +275,27 @@ def turbulence_response(
         Relative accuracy asked of each integral.
     omega_hi : float, optional
         Start of the closed-form tail [rad/s]; default 1000 x the larger of the spectral
-        radius of A and V / L. Must exceed 10 x the spectral radius (Markov series).
+        radius of A and V / L (in closed loop at least 100 x the start ``omega_a`` of the
+        period averages). Must exceed 10 x the spectral radius (Markov series) and, in closed
+        loop, 2 ``omega_a``.
+    controller : optional
+        Anything :func:`aeroservo.design.as_controller` accepts with a linear law (a gain
+        schedule is evaluated at ``sys.speed``; an MPC gives its law without active
+        constraints); :class:`aeroservo.design.OpenLoop` is the open loop.
+    delay : bool
+        One-sample computational delay.
+    sample_rate : float, optional
+        [Hz], to discretise a continuous python-control compensator.
 
     Returns
     -------
     TurbulenceResult
+
+    Raises
+    ------
+    InputError
+        Unknown names, an unstable model (open loop) or loop (spectral radius >= 1), a
+        controller without a linear law.
     """
     spec = spectrum if spectrum is not None else von_karman()
     v = speed if speed is not None else getattr(sys, "speed", None)
@@ -290,59 +312,46 @@ def turbulence_response(
             raise InputError(f"output {n!r}: not an output of the model ({names})")
     if not outputs:
         raise InputError("outputs: the model has none of the default loads; name them")
-    iu = inputs.index(gust_input)
+    iw = inputs.index(gust_input)
     rows = [names.index(n) for n in outputs]
+    loop = None
+    if controller is not None:
+        loop = _sampled_loop(sys, controller, delay, sample_rate, rows, iw, v)
     a = np.asarray(sys.A, dtype=float)
-    resp = _Response(
-        a,
-        np.asarray(sys.B, dtype=float)[:, iu],
-        np.asarray(sys.C, dtype=float)[rows],
-        np.asarray(sys.D, dtype=float)[rows, iu],
-    )
-    if np.max(resp.lam.real) >= 0:
-        raise InputError(
-            f"speed = {v:g} m/s: the model is unstable (max Re(eig) = "
-            f"{np.max(resp.lam.real):.3g} 1/s); turbulence RMS is defined for stable models only"
-        )
     scale = float(spec.psd(np.array([0.0]))[0]) * math.pi  # L from Phi(0) = L / pi
-    rho = float(np.max(np.abs(resp.lam)))
-    w_hi = 1000.0 * max(rho, v / scale)
-    if omega_hi is not None:
-        w_hi = check_number("omega_hi", omega_hi, unit="rad/s", lo=10.0 * max(rho, v / scale))
-
-    def psd(w):
-        return spec.time_psd(w, v)
-
-    pts = _breakpoints(resp.lam, v, scale, w_hi)
-    lo, hi = pts[:-1], pts[1:]
-    tail0, tail2 = _tail(resp, spec, v, w_hi)
-    done0 = np.zeros(len(rows))
-    done2 = np.zeros(len(rows))
-    for _ in range(40):
-        log = lo > 0
-        c0, c2 = _panel_integrals(resp, psd, lo, hi, log)
-        mid = np.where(log, np.sqrt(lo * np.where(log, hi, 1.0)), (lo + hi) / 2)
-        l0, l2 = _panel_integrals(resp, psd, lo, mid, log)
-        r0, r2 = _panel_integrals(resp, psd, mid, hi, log)
-        f0, f2 = l0 + r0, l2 + r2
-        tot0 = done0 + f0.sum(axis=0) + tail0
-        tot2 = done2 + f2.sum(axis=0) + np.where(np.isfinite(tail2), tail2, 0.0)
-        err = np.maximum(
-            np.max(np.abs(f0 - c0) / tot0, axis=1), np.max(np.abs(f2 - c2) / tot2, axis=1)
+    if loop is None:
+        resp = ModalResponse(
+            a,
+            np.asarray(sys.B, dtype=float)[:, iw],
+            np.asarray(sys.C, dtype=float)[rows],
+            np.asarray(sys.D, dtype=float)[rows, iw],
         )
-        bad = err > 0.1 * rtol
-        done0 += f0[~bad].sum(axis=0)
-        done2 += f2[~bad].sum(axis=0)
-        if not bad.any():
-            break
-        lo = np.concatenate([lo[bad], mid[bad]])
-        hi = np.concatenate([mid[bad], hi[bad]])
+        if np.max(resp.lam.real) >= 0:
+            raise InputError(
+                f"speed = {v:g} m/s: the model is unstable (max Re(eig) = "
+                f"{np.max(resp.lam.real):.3g} 1/s); turbulence RMS is defined for stable "
+                "models only (or give the controller that stabilises it)"
+            )
+        lam = resp.lam
     else:
-        raise RuntimeError("turbulence quadrature did not converge in 40 refinements")
-    var = done0 + tail0
-    second = done2 + tail2
+        lam = loop[0].ol.lam
+    rho = float(np.max(np.abs(lam)))
+    lo = 10.0 * max(rho, v / scale)
+    w_hi = 1000.0 * max(rho, v / scale)
+    if loop is not None:
+        w_a = alias_start(rho, loop[0].dt)
+        lo, w_hi = max(lo, 2.0 * w_a), max(w_hi, 100.0 * w_a)
+    if omega_hi is not None:
+        w_hi = check_number("omega_hi", omega_hi, unit="rad/s", lo=lo)
+    if loop is None:
+        total, tail = _open_moments(resp, spec, v, scale, w_hi, rtol)
+    else:
+        total, tail = loop_moments(loop[0], loop[1], spec, v, scale, w_a, w_hi, rtol)
+    cov, second = unpack(total, len(rows))
+    var = np.diag(cov)
     a_bar = np.sqrt(var)
     n0 = np.sqrt(second / var) / (2 * math.pi)
+    tail_var = np.diag(unpack(tail, len(rows))[0])
     units = getattr(sys, "signal_units", {}) or {}
     return TurbulenceResult(
         a_bar={n: float(x) for n, x in zip(outputs, a_bar, strict=True)},
@@ -351,5 +360,9 @@ def turbulence_response(
         speed=v,
         spectrum=spec.name,
         omega_hi=w_hi,
-        tail_fraction={n: float(t / x) for n, t, x in zip(outputs, tail0, var, strict=True)},
+        tail_fraction={n: float(t / x) for n, t, x in zip(outputs, tail_var, var, strict=True)},
+        covariance=cov,
+        outputs=tuple(outputs),
+        controller="open loop" if loop is None else loop[2],
+        sample_rate=None if loop is None else loop[3],
     )

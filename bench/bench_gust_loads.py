@@ -1,0 +1,92 @@
+"""Gust-loads benchmarks (targets from issue 29), with a same-run baseline.
+
+Goland wing with aileron, 10 elements, sea level, 0.9 V_f, the LQR loop of
+``scenarios/goland_aileron_lqr.toml`` (1 kHz, actuator limits), six loads:
+
+* a 10-gradient x 2-sign tuned-gust search (no refinement), open and closed loop: < 2 s;
+* the turbulence A-bar and N0 of every load at one flight point, open and closed loop: < 0.5 s;
+* the same search refined (the default), for information;
+* baseline: one open-loop flutter boundary of the same model (``flutter_boundary``), reported
+  as the ratio of each figure to it.
+"""
+
+from __future__ import annotations
+
+import inspect
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from aeroservo.files.scenario_file import load_scenario
+from aeroservo.stability.boundary import flutter_boundary
+from aeroservo.studies.tuned_gusts import tuned_gust_loads
+from aeroservo.studies.turbulence import turbulence_response
+
+LOADS = [
+    "root_shear",
+    "root_bending_moment",
+    "root_torque",
+    "tip_le_accel",
+    "tip_te_accel",
+    "aileron_aero_hinge_moment",
+]
+
+
+def median(fn, n: int) -> float:
+    out = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return statistics.median(out)
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv[1:]
+    root = Path(__file__).resolve().parents[1]
+    sc = load_scenario(root / "scenarios" / "goland_aileron_lqr.toml")
+    model = sc.model()
+    vf = flutter_boundary(model, sc.density).flutter_speed
+    from dataclasses import replace
+
+    sc = replace(sc, outputs=tuple(dict.fromkeys(sc.outputs + tuple(LOADS))))
+    loop = sc.loop(model)
+    ctrl = loop.design_controller(sc.controller, 1.1 * vf, sc.sample_rate, vf)
+    plant = loop.plant(0.9 * vf)
+    plant.density = sc.density
+    lim = sc.controller.limits
+    base = median(lambda: flutter_boundary(model, sc.density), 5)
+
+    def search(**kw):
+        return tuned_gust_loads(plant, 0.0, n_gradients=10, **kw)
+
+    t_ol = median(lambda: search(refine=False), 3)
+    t_cl = median(lambda: search(refine=False, controller=ctrl, limits=lim), 3)
+    t_ol_r = None if quick else median(lambda: search(), 1)
+    t_cl_r = None if quick else median(lambda: search(controller=ctrl, limits=lim), 1)
+    turb_ol = median(lambda: turbulence_response(plant, LOADS), 5)
+    closed_ok = "controller" in inspect.signature(turbulence_response).parameters
+    turb_cl = (
+        median(lambda: turbulence_response(plant, LOADS, controller=ctrl), 5) if closed_ok else None
+    )
+
+    print("aeroservo gust loads (10-element Goland with aileron, 0.9 V_f, LQR at 1 kHz, medians)")
+    print(f"  baseline: one flutter boundary:              {base * 1e3:8.1f} ms")
+    for label, t, target in (
+        ("tuned gusts, 10 H, open loop (down = -up)", t_ol, 2.0),
+        ("tuned gusts, 10 H x 2 signs, closed loop", t_cl, 2.0),
+        ("tuned gusts refined, open loop", t_ol_r, None),
+        ("tuned gusts refined, closed loop", t_cl_r, None),
+        ("turbulence A-bar, 6 loads, open loop", turb_ol, 0.5),
+        ("turbulence A-bar, 6 loads, closed loop", turb_cl, 0.5),
+    ):
+        if t is None:
+            print(f"  {label:44s} not run")
+            continue
+        goal = f"  target < {target:g} s: {'PASS' if t < target else 'FAIL'}" if target else ""
+        print(f"  {label:44s} {t:7.3f} s = {t / base:6.1f} x boundary{goal}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,177 @@
+"""Gust-loads result files: a :class:`~aeroservo.studies.gust_results.GustLoadsResult` as
+``<stem>.json`` (the run's summary, the study's settings, the load units and every record) and
+``<stem>.npz`` (the time histories of the critical gusts), with the limit-load table
+``<stem>.csv`` and, when both loops were run, the gust-load-alleviation table
+``<stem>_alleviation.csv``. :func:`load_gust_loads` reads the JSON and NPZ back into an equal
+result (the figures redraw from it). No pickled objects: a damaged or foreign file is one
+:class:`~aeroservo.errors.InputError`.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from ..atomic import atomic_write_set
+from ..errors import InputError
+from ..studies.gust_results import GustLoadsResult
+from .summaries import json_text
+from .user_files import MAX_RESULT_BYTES, read_bytes, user_path
+
+__all__ = [
+    "FORMAT",
+    "gust_loads_items",
+    "write_gust_loads",
+    "load_gust_loads",
+    "is_gust_loads_file",
+]
+
+FORMAT = "aeroservo-gust-loads-1"
+_RECORD_KEYS = ("point", "loop", "loads", "histories", "history_loads", "limited")
+
+
+def _json_writer(result: GustLoadsResult, summary: dict, npz: Path):
+    """The JSON's writer; the text is made when it writes (``summary`` may still grow)."""
+
+    def write(p: Path) -> None:
+        doc = {
+            "format": FORMAT,
+            **summary,
+            "name": result.name,
+            "units": dict(result.units),
+            "settings": dict(result.settings),
+            "arrays": npz.name,
+            "records": result.records,
+        }
+        p.write_text(json_text(doc), encoding="utf-8")
+
+    return write
+
+
+def _npz_writer(arrays: dict):
+    def write(p: Path) -> None:
+        with open(p, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    return write
+
+
+def _csv_writer(frame):
+    """A writer of the CSV of ``frame()`` (a DataFrame made when it writes)."""
+    return lambda p: p.write_text(frame().to_csv(index=False), encoding="utf-8")
+
+
+def gust_loads_items(result: GustLoadsResult, json_path: str | Path, summary: dict) -> dict:
+    """The files of a result, ``{kind: (path, writer)}`` for
+    :func:`aeroservo.atomic.atomic_write_set`: ``summary`` (the JSON: ``summary`` and every
+    record), ``arrays`` (the NPZ next to it), ``table`` (the CSV of limit loads) and
+    ``alleviation`` (its CSV, when the result has both loops). The texts are made when the
+    writers run, so ``summary`` may still be completed (e.g. with the files written)."""
+    json_path = Path(json_path)
+    stem = json_path.with_suffix("")
+    npz = stem.with_suffix(".npz")
+    items = {
+        "summary": (json_path, _json_writer(result, summary, npz)),
+        "arrays": (npz, _npz_writer(result.arrays)),
+        "table": (stem.with_suffix(".csv"), _csv_writer(lambda: result.table)),
+    }
+    if result.loops == ["open", "closed"]:
+        path = stem.parent / f"{stem.name}_alleviation.csv"
+        items["alleviation"] = (path, _csv_writer(lambda: result.alleviation))
+    return items
+
+
+def write_gust_loads(
+    result: GustLoadsResult, path: str | Path, summary: dict | None = None
+) -> dict[str, str]:
+    """Write a gust-loads result (atomically, all files or none).
+
+    Parameters
+    ----------
+    result : GustLoadsResult
+    path : str or Path
+        The ``.json`` file; the ``.npz``, ``.csv`` and ``_alleviation.csv`` go next to it.
+    summary : dict, optional
+        The run's summary (default :func:`aeroservo.studies.gust_scenario.gust_summary`).
+
+    Returns
+    -------
+    dict
+        ``{kind: path}`` of the files written.
+    """
+    from ..studies.gust_scenario import gust_summary
+
+    path = user_path(path, "gust-loads result (.json)")
+    if path.suffix.lower() != ".json":
+        raise InputError(f"path = {str(path)!r}: expected a .json file name")
+    items = gust_loads_items(result, path, summary or gust_summary(result))
+    atomic_write_set(list(items.values()))
+    return {k: str(p) for k, (p, _w) in items.items()}
+
+
+def is_gust_loads_file(path: str | Path) -> bool:
+    """Whether ``path`` is a ``.json`` file written by :func:`write_gust_loads` (its first
+    kilobytes name the format)."""
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        return False
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except (OSError, ValueError):
+        return False
+    return f'"format": "{FORMAT}"'.encode() in head
+
+
+def _fail(path: Path, what: str):
+    raise InputError(f"{path}: not a valid aeroservo gust-loads result ({what})")
+
+
+def load_gust_loads(path: str | Path) -> GustLoadsResult:
+    """Read a result written by :func:`write_gust_loads` (or ``aeroservo loads``): the JSON and
+    the NPZ it names, next to it.
+
+    Raises
+    ------
+    InputError
+        The file is missing, not a gust-loads result, or its NPZ is missing or incomplete.
+    """
+    path = user_path(path, "gust-loads result (.json)")
+    raw = read_bytes(path, what="gust-loads result (.json)", limit=MAX_RESULT_BYTES)
+    try:
+        doc = json.loads(raw.decode("utf-8-sig"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        _fail(path, f"not JSON: {' '.join(str(exc).split())}")
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else None
+        _fail(path, f"format {found!r}, expected {FORMAT!r}")
+    records = doc.get("records")
+    if not isinstance(records, list) or not all(
+        isinstance(r, dict) and all(k in r for k in _RECORD_KEYS) for r in records
+    ):
+        _fail(path, f"'records' must be a list of records with {list(_RECORD_KEYS)}")
+    name = doc.get("arrays")
+    if not isinstance(name, str) or Path(name).name != name or not name.endswith(".npz"):
+        _fail(path, f"'arrays' = {name!r}: expected the name of a .npz file next to it")
+    npz = path.parent / name
+    raw = read_bytes(npz, what="gust-loads histories (.npz)", limit=MAX_RESULT_BYTES)
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
+        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"{npz}: not a .npz archive of gust histories ({why})") from None
+    for r in records:
+        for sides in r["histories"].values():
+            for key in sides.values():
+                for end in ("_t", "_gust", "_y"):
+                    if key + end not in arrays:
+                        raise InputError(f"{npz}: missing array {key + end!r} (named by {path})")
+    units, settings = doc.get("units", {}), doc.get("settings", {})
+    if not isinstance(units, dict) or not isinstance(settings, dict):
+        _fail(path, "'units' and 'settings' must be tables")
+    return GustLoadsResult(str(doc.get("name", path.stem)), records, arrays, units, settings)

@@ -1,0 +1,352 @@
+"""The result of a gust-loads study as data: one record per flight point and loop, the time
+histories of the critical gusts, the limit-load table, the worst case per load and the
+gust-load-alleviation effect of the loop.
+
+Records are plain JSON values (SI units, radians) and the histories numpy arrays, so that a
+result written by :mod:`aeroservo.files.gust_loads_file` reads back into the same object and
+every figure (:mod:`aeroservo.studies.gust_plots`) redraws from it.
+
+Definitions:
+
+* discrete limit load of a load at a point: ``max(|maximum|, |minimum|)`` of its tuned
+  discrete gusts (incremental);
+* turbulence limit load: ``U_sigma A_bar``;
+* limit load: the larger of the two;
+* gust load alleviation of the loop (per load and per point, discrete and turbulence):
+  ``100 (1 - closed / open)`` [%] of the limit loads; a loop **raises** a load when the closed
+  loop's limit load exceeds the open loop's by more than :data:`RAISE_TOLERANCE`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["GustLoadsResult", "point_records", "RAISE_TOLERANCE"]
+
+RAISE_TOLERANCE = 1e-3
+"""Relative increase of a limit load above which the loop is said to raise it (0.1 %: ten
+times the accuracy of the sampled march against the exact one, ``docs/gust-loads.md``)."""
+
+
+def _extreme_record(e, turb, u_sig: float) -> dict:
+    rec = {"unit": e.unit}
+    for side in ("max", "min"):
+        value, h, t, sign, corr = e.side(side)
+        rec.update(
+            {
+                side: value,
+                f"{side}_gradient": h,
+                f"{side}_time": t,
+                f"{side}_sign": sign,
+                f"{side}_correlated": dict(corr),
+            }
+        )
+    rec["discrete"] = max(abs(e.maximum), abs(e.minimum))
+    if turb is not None and e.load in turb.a_bar:
+        rec.update(
+            a_bar=turb.a_bar[e.load], n0=turb.n0[e.load], turbulence=u_sig * turb.a_bar[e.load]
+        )
+    return rec
+
+
+def point_records(index: int, pl, loads) -> tuple[list[dict], dict]:
+    """JSON records and history arrays of one :class:`~aeroservo.studies.gust_loads.PointLoads`
+    (``index``: its place in the study); the records keep ``loads`` and the controls applied,
+    the histories every output."""
+    p = pl.point
+    base = {
+        "point": index,
+        "mass_case": p.mass_case,
+        "altitude": p.altitude,
+        "speed_name": p.speed_name,
+        "eas": p.speed,
+        "tas": p.tas,
+        "density": p.density,
+        "f_g": pl.f_g,
+        "u_sigma": pl.u_sigma,
+        "open_loop_stable": pl.open_loop_stable,
+        "notes": list(pl.notes),
+        "elapsed": pl.elapsed,
+    }
+    records, arrays = [], {}
+    for loop, d in pl.discrete.items():
+        turb = pl.turbulence.get(loop)
+        rec = dict(base, loop=loop, controller=d.controller, gust_speed=d.speed)
+        keep = [n for n in d.extremes if n in loads or n in d.limited]
+        rec["loads"] = {n: _extreme_record(d.extremes[n], turb, pl.u_sigma) for n in keep}
+        rec["limited"] = {c: float(np.max(a)) for c, a in d.limited.items()}
+        rec["gradients"] = [float(h) for h in d.gradients]
+        neg = d.peaks_negative if d.peaks_negative is not None else -d.peaks[:, :, ::-1]
+        rec["tuning"] = {  # peak of each load over time per scanned gradient, both gust signs
+            n: {
+                "up_max": d.peaks[:, i, 0].tolist(),
+                "up_min": d.peaks[:, i, 1].tolist(),
+                "down_max": neg[:, i, 0].tolist(),
+                "down_min": neg[:, i, 1].tolist(),
+            }
+            for i, n in enumerate(d.loads)
+            if n in keep
+        }
+        rec["amplitudes"] = [float(a) for a in d.amplitudes]
+        if turb is not None:
+            rec["covariance"] = {
+                "outputs": list(turb.outputs),
+                "matrix": np.asarray(turb.covariance).tolist(),
+            }
+        keys = {}
+        for (h, sign), (t, gust, y) in d.histories.items():
+            key = f"p{index}_{loop}_H{h:.6g}_{'up' if sign > 0 else 'down'}"
+            arrays[key + "_t"], arrays[key + "_gust"], arrays[key + "_y"] = t, gust, y
+            keys[f"{h!r} {sign}"] = key
+        rec["history_loads"] = list(d.loads)
+        rec["histories"] = {
+            name: {s: keys[f"{e.side(s)[1]!r} {e.side(s)[3]}"] for s in ("max", "min")}
+            for name, e in d.extremes.items()
+            if name in keep
+        }
+        records.append(rec)
+    return records, arrays
+
+
+@dataclass
+class GustLoadsResult:
+    """Records of a gust-loads study (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+    records : list of dict
+        One per flight point and loop (``"open"``, ``"closed"``).
+    arrays : dict
+        History arrays by key (``<key>_t`` [s], ``<key>_gust`` [m/s], ``<key>_y``).
+    units : dict
+        Load units.
+    settings : dict
+        The study's settings (JSON values).
+    """
+
+    name: str
+    records: list
+    arrays: dict = field(default_factory=dict)
+    units: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def loads(self) -> list[str]:
+        """Load names, in the order of the first record."""
+        names: list[str] = []
+        for r in self.records:
+            names += [n for n in r["loads"] if n not in names]
+        return names
+
+    @property
+    def loops(self) -> list[str]:
+        """``"open"`` and/or ``"closed"``."""
+        return [lp for lp in ("open", "closed") if any(r["loop"] == lp for r in self.records)]
+
+    @property
+    def table(self):
+        """Limit loads: one row per flight point, loop and load (pandas DataFrame)."""
+        import pandas as pd
+
+        rows = []
+        for r in self.records:
+            for name, v in r["loads"].items():
+                turb = v.get("turbulence", np.nan)
+                rows.append(
+                    {
+                        "point": r["point"],
+                        "mass_case": r["mass_case"],
+                        "altitude_m": r["altitude"],
+                        "speed": r["speed_name"],
+                        "eas_m_s": r["eas"],
+                        "tas_m_s": r["tas"],
+                        "f_g": r["f_g"],
+                        "u_sigma_m_s": r["u_sigma"],
+                        "loop": r["loop"],
+                        "load": name,
+                        "unit": v["unit"],
+                        "discrete_max": v["max"],
+                        "max_gradient_m": v["max_gradient"],
+                        "max_time_s": v["max_time"],
+                        "max_sign": v["max_sign"],
+                        "discrete_min": v["min"],
+                        "min_gradient_m": v["min_gradient"],
+                        "min_time_s": v["min_time"],
+                        "min_sign": v["min_sign"],
+                        "a_bar": v.get("a_bar", np.nan),
+                        "n0_hz": v.get("n0", np.nan),
+                        "turbulence": turb,
+                        "limit": np.nanmax([v["discrete"], turb]),
+                        "saturated": max(r["limited"].values(), default=0.0),
+                    }
+                )
+        return pd.DataFrame(rows)
+
+    def worst(self, loop: str = "closed"):
+        """The largest limit load of each load over every flight point and mass case of
+        ``loop`` (``"open"`` or ``"closed"``): a DataFrame indexed by load."""
+        if loop not in self.loops:
+            raise InputError(f"loop = {loop!r}: the result has {self.loops}")
+        t = self.table
+        t = t[t["loop"] == loop]
+        rows = t.loc[t.groupby("load", sort=False)["limit"].idxmax()]
+        rows = rows.assign(
+            source=np.where(
+                rows["turbulence"] > rows[["discrete_max", "discrete_min"]].abs().max(axis=1),
+                "turbulence",
+                "discrete",
+            )
+        )
+        return rows.set_index("load")
+
+    @property
+    def alleviation(self):
+        """Gust load alleviation of the loop per flight point and load [%] (DataFrame), and
+        ``raised``: the loop raises the discrete or turbulence limit load."""
+        import pandas as pd
+
+        if self.loops != ["open", "closed"]:
+            raise InputError(
+                "gust load alleviation needs both loops at a flight point; this result has "
+                f"{self.loops or 'none'}"
+            )
+        t = self.table
+        key = ["point", "load"]
+        o = t[t["loop"] == "open"].set_index(key)
+        c = t[t["loop"] == "closed"].set_index(key)
+        both = o.index.intersection(c.index)
+        out = pd.DataFrame(index=both)
+        for what in ("discrete", "turbulence"):
+            if what == "discrete":
+                ov = o.loc[both, ["discrete_max", "discrete_min"]].abs().max(axis=1)
+                cv = c.loc[both, ["discrete_max", "discrete_min"]].abs().max(axis=1)
+            else:
+                ov, cv = o.loc[both, "turbulence"], c.loc[both, "turbulence"]
+            out[f"{what}_open"], out[f"{what}_closed"] = ov, cv
+            out[f"{what}_alleviation_pct"] = 100.0 * (1.0 - cv / ov)
+        rel = np.fmax(
+            out["discrete_closed"] / out["discrete_open"],
+            out["turbulence_closed"] / out["turbulence_open"],
+        )
+        out["raised"] = rel > 1.0 + RAISE_TOLERANCE
+        return out.reset_index()
+
+    def raised_loads(self) -> list[str]:
+        """One line per load the loop raises, at its worst flight point."""
+        if self.loops != ["open", "closed"]:
+            return []
+        a = self.alleviation
+        lines = []
+        for load, g in a[a["raised"]].groupby("load", sort=False):
+            k = g[["discrete_alleviation_pct", "turbulence_alleviation_pct"]].min(axis=1).idxmin()
+            row = g.loc[k]
+            rec = next(r for r in self.records if r["point"] == row["point"])
+            parts = [
+                f"{what} {-row[f'{what}_alleviation_pct']:+.1f} %"
+                for what in ("discrete", "turbulence")
+                if np.isfinite(row[f"{what}_alleviation_pct"])
+            ]
+            lines.append(f"the loop raises {load} at {_point_label(rec)}: " + ", ".join(parts))
+        return lines
+
+    def history(self, point: int, loop: str, load: str, side: str = "max"):
+        """``(t [s], gust [m/s true], {load: values})`` of the gust critical for ``load``."""
+        rec = self.record(point, loop)
+        if load not in rec["histories"]:
+            raise InputError(f"load {load!r}: not in the result ({list(rec['histories'])})")
+        key = rec["histories"][load][side]
+        y = self.arrays[key + "_y"]
+        names = rec["history_loads"]
+        return (
+            self.arrays[key + "_t"],
+            self.arrays[key + "_gust"],
+            {n: y[:, i] for i, n in enumerate(names)},
+        )
+
+    def record(self, point: int, loop: str) -> dict:
+        """The record of flight point ``point`` (its index) and ``loop``."""
+        for r in self.records:
+            if r["point"] == point and r["loop"] == loop:
+                return r
+        raise InputError(
+            f"no record for point {point} and loop {loop!r} (points "
+            f"{sorted({r['point'] for r in self.records})}, loops {self.loops})"
+        )
+
+    def summary_text(self) -> str:
+        """A loads engineer's summary: worst limit load per load and loop, GLA, flags."""
+        lines = [f"gust loads {self.name}: {len({r['point'] for r in self.records})} points"]
+        for loop in self.loops:
+            w = self.worst(loop)
+            lines.append(f"  {loop} loop, worst limit load (incremental, clamped wing):")
+            for load, row in w.iterrows():
+                rec = self.record(int(row["point"]), loop)
+                lines.append(
+                    f"    {load:28s} {row['limit']:12.5g} {row['unit']:7s} {row['source']:10s}"
+                    f" at {_point_label(rec)}"
+                )
+        seen = set()
+        for r in self.records:
+            for note in r["notes"]:  # a point's notes are in each of its loops' records
+                if (r["point"], note) not in seen:
+                    seen.add((r["point"], note))
+                    lines.append(f"  note, {_point_label(r)}: {note}")
+            sat = {c: s for c, s in r["limited"].items() if s > 0}
+            if sat:
+                parts = ", ".join(f"{c} {100 * s:.1f} % of samples" for c, s in sat.items())
+                lines.append(
+                    f"  {r['loop']} loop at {_point_label(r)}: actuator limit hit ({parts})"
+                )
+        for sk in self.settings.get("skipped_points", []):
+            why = "; ".join(sk["notes"]) or "no loop computed"
+            lines.append(f"  NO LOADS at point {sk['point']} ({sk['flight_point']}): {why}")
+        for line in self.raised_loads():
+            lines.append(f"  WARNING: {line}")
+        return "\n".join(lines)
+
+    # figures (aeroservo.studies.gust_plots): thin delegates, matplotlib imported on use
+
+    def plot_envelope(self):
+        """Limit loads per flight point (:func:`~aeroservo.studies.gust_plots.plot_envelope`)."""
+        from .gust_plots import plot_envelope
+
+        return plot_envelope(self)
+
+    def plot_correlated(self, x="root_bending_moment", y="root_torque", *, point=None, loop=None):
+        """Correlated loads x against y with the discrete-gust points and the turbulence design
+        ellipse (:func:`~aeroservo.studies.gust_plots.plot_correlated`)."""
+        from .gust_plots import plot_correlated
+
+        return plot_correlated(self, x, y, point=point, loop=loop)
+
+    def plot_gust_history(self, point: int, load: str, side: str = "max"):
+        """The critical gust of ``load`` at flight point ``point``
+        (:func:`~aeroservo.studies.gust_plots.plot_gust_history`)."""
+        from .gust_plots import plot_gust_history
+
+        return plot_gust_history(self, point, load, side)
+
+    def plot_critical_gusts(self, loads=None, loop=None):
+        """The critical gust of every load at its worst flight point
+        (:func:`~aeroservo.studies.gust_plots.plot_critical_gusts`)."""
+        from .gust_plots import plot_critical_gusts
+
+        return plot_critical_gusts(self, loads, loop)
+
+    def plot_tuning(self, point: int, load: str):
+        """Peak load against the gust gradient H at a flight point
+        (:func:`~aeroservo.studies.gust_plots.plot_tuning`)."""
+        from .gust_plots import plot_tuning
+
+        return plot_tuning(self, point, load)
+
+
+def _point_label(rec: dict) -> str:
+    case = f"{rec['mass_case']} " if rec["mass_case"] else ""
+    name = f" {rec['speed_name']}" if rec["speed_name"] else ""
+    return f"{case}{rec['altitude']:g} m{name} {rec['eas']:.4g} m/s EAS"
