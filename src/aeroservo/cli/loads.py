@@ -4,7 +4,6 @@ loop, over its flight points (in this process or on Dask), written as one set of
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ..errors import InputError
 
@@ -74,32 +73,16 @@ def run_loaded(scenario, args: argparse.Namespace) -> int:
     """Run a loaded ``gust_loads`` scenario with the options of ``loads`` (or of ``run``), write
     its files and print its summary."""
     from dataclasses import replace
-    from pathlib import Path
 
-    from ..files.outputs import write_run
     from ..files.summaries import json_text
-    from ..studies.runs import run_scenario
     from ..studies.scenario import quick
+    from .options import run_into_folder
 
     if args.quick:
         scenario = quick(scenario)
     if getattr(args, "no_plots", False):
         scenario = replace(scenario, plots=False)
-    if not args.out.strip():
-        raise InputError("--out = '': give an output folder")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out = {args.out!r}: is a file, expected a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    progress = sys.stderr.isatty() if args.progress is None else args.progress
-    run = run_scenario(
-        scenario,
-        out,
-        progress=progress,
-        scheduler=getattr(args, "scheduler", None),
-        workers=getattr(args, "workers", None),
-    )
-    files = write_run(run, out)
+    run, files = run_into_folder(scenario, args)
     if args.json:
         print(json_text(run.summary))
         return 0

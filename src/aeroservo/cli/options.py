@@ -280,3 +280,30 @@ def check_suffix(option: str, path: str | None, suffix: str) -> None:
     if Path(path).suffix.lower() != suffix:
         raise InputError(f"{option} = {path!r}: expected a {suffix} file name")
     check_output_path(path, option)
+
+
+def run_into_folder(scenario, args: argparse.Namespace):
+    """Run a loaded scenario into the folder ``args.out`` (created; refused if it is a file)
+    with the progress, scheduler and worker options of ``args``, and write its files as one
+    set; returns ``(run, {kind: path})``."""
+    import sys
+    from pathlib import Path
+
+    from ..files.outputs import write_run
+    from ..studies.runs import run_scenario
+
+    if not args.out.strip():
+        raise InputError("--out = '': give an output folder")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out = {args.out!r}: is a file, expected a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    progress = sys.stderr.isatty() if args.progress is None else args.progress
+    run = run_scenario(
+        scenario,
+        out,
+        progress=progress,
+        scheduler=getattr(args, "scheduler", None),
+        workers=getattr(args, "workers", None),
+    )
+    return run, write_run(run, out)

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..errors import InputError
-from .options import positive_int
+from .options import positive_int, run_into_folder
 
 __all__ = ["add_parsers", "HANDLERS"]
 
@@ -75,12 +75,9 @@ def _cmd_examples(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
 
-    from ..files.outputs import write_run
     from ..files.scenario_file import load_scenario
     from ..files.summaries import json_text
-    from ..studies.runs import run_scenario
     from ..studies.scenario import quick
 
     scenario = load_scenario(args.scenario)
@@ -95,26 +92,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
         return run_loaded(scenario, args)
     if args.quick:
         scenario = quick(scenario)
-    if not args.out.strip():
-        raise InputError("--out = '': give an output folder")
     if getattr(args, "scheduler", None) and scenario.kind != "trade":
         raise InputError(
             f"--scheduler = {args.scheduler!r}: only a trade study runs on a Dask cluster; "
             f"{args.scenario} is a {scenario.kind} scenario"
         )
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out = {args.out!r}: is a file, expected a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    progress = sys.stderr.isatty() if args.progress is None else args.progress
-    run = run_scenario(
-        scenario,
-        out,
-        progress=progress,
-        scheduler=getattr(args, "scheduler", None),
-        workers=getattr(args, "workers", None),
-    )
-    write_run(run, out)
+    run, _ = run_into_folder(scenario, args)
     summary = run.summary
     if args.json:
         print(json_text(summary))

@@ -160,8 +160,9 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
     """Checks that need the wings: each load an output of every mass case's model; with a
     controller, its controls, sensors and outputs on every mass case and its file's signals."""
     from ..design.loop import check_spec_signals
-    from ..linear.signals import input_names, resolve_outputs
+    from ..linear.signals import resolve_outputs
     from ..system.aeroelastic import AeroelasticModel
+    from .scenario_checks import check_loop_signals
 
     g = s.gust_loads
     gl, sg = top.table("gust_loads"), top.table("signals")
@@ -177,30 +178,7 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
                 gl.fail(f"loads[{i}]", name, f"not an output of the model{where}; {known}")
         if spec is None:
             continue
-        if not wing.control_surfaces:
-            sg.fail("controls", list(s.controls), f"the wing has no control surface{where}")
-        inputs = input_names(wing)
-        for c in s.controls:
-            if c not in inputs or c == "gust":
-                allowed = sorted(k for k in inputs if k != "gust")
-                sg.fail(
-                    "controls",
-                    list(s.controls),
-                    f"{c!r} is not a control{where}; allowed {allowed}",
-                )
-        if s.design_modes is not None and s.design_modes > model.n_dofs:
-            top.table("model").fail(
-                "design_modes",
-                s.design_modes,
-                f"more than the {model.n_dofs} degrees of freedom of {s.elements} elements",
-            )
-        for key in ("sensors", "outputs"):
-            names = list(getattr(s, key))
-            for name in names:
-                try:
-                    resolve_outputs(model, [name], model.n_dofs)
-                except InputError as exc:
-                    sg.fail(key, names, f"{exc}{where}")
+        check_loop_signals(s, wing, model, top, where)
     if spec is None:
         return
     if s.sensor_filter is not None and s.sensor_filter >= 0.5 * s.sample_rate:

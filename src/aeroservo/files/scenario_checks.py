@@ -26,25 +26,21 @@ def _check_study(s: Scenario) -> None:
         raise InputError(f"{s.source}: trade: {exc}") from None
 
 
-def cross_check(s: Scenario, top: Table) -> None:
-    """Checks that need the wing: signal names, stations, limits against the initial state."""
-    from ..design.loop import check_spec_signals
+def check_loop_signals(s: Scenario, wing, model, top: Table, where: str = "") -> None:
+    """A loop's controls, sensors and outputs on ``wing`` (its ``model``), and the design
+    modes; ``where`` ends each message (e.g. the mass case)."""
     from ..linear.signals import input_names, resolve_outputs
 
-    if s.kind == "flutter":
-        return
-    if s.kind == "trade" and not s.trade["closed_loop"]:  # no loop: the study's checks only
-        _check_study(s)
-        return
     sg = top.table("signals")
-    if not s.wing.control_surfaces:
-        sg.fail("controls", list(s.controls), "the wing has no control surface to drive")
-    inputs = input_names(s.wing)
+    if not wing.control_surfaces:
+        sg.fail("controls", list(s.controls), f"the wing has no control surface to drive{where}")
+    inputs = input_names(wing)
     for c in s.controls:
         if c not in inputs or c == "gust":
             allowed = sorted(k for k in inputs if k != "gust")
-            sg.fail("controls", list(s.controls), f"{c!r} is not a control; allowed {allowed}")
-    model = s.model()
+            sg.fail(
+                "controls", list(s.controls), f"{c!r} is not a control{where}; allowed {allowed}"
+            )
     if s.design_modes is not None and s.design_modes > model.n_dofs:
         top.table("model").fail(
             "design_modes",
@@ -57,7 +53,21 @@ def cross_check(s: Scenario, top: Table) -> None:
             try:
                 resolve_outputs(model, [name], model.n_dofs)
             except InputError as exc:
-                sg.fail(key, names, str(exc))
+                sg.fail(key, names, f"{exc}{where}")
+
+
+def cross_check(s: Scenario, top: Table) -> None:
+    """Checks that need the wing: signal names, stations, limits against the initial state."""
+    from ..design.loop import check_spec_signals
+
+    if s.kind == "flutter":
+        return
+    if s.kind == "trade" and not s.trade["closed_loop"]:  # no loop: the study's checks only
+        _check_study(s)
+        return
+    sg = top.table("signals")
+    model = s.model()
+    check_loop_signals(s, s.wing, model, top)
     if s.sensor_filter is not None and s.sensor_filter >= 0.5 * s.sample_rate:
         sg.fail(
             "sensor_filter",
