@@ -370,4 +370,4 @@ def test_no_loads_at_any_point_is_an_input_error(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert f"{path}: gust_loads.points: no flight point has loads: the open loop is unstable" in err
-    assert list(out.iterdir()) == []
+    assert not out.exists()  # the folder this failed run made is removed

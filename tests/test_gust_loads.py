@@ -197,3 +197,20 @@ def test_a_point_without_any_loop_is_kept_with_its_reasons():
     text = res.summary_text()
     assert "NO LOADS at point 1" in text
     assert text.count("closed loop at 100 m/s TAS is unstable") == 1  # one note per point
+
+
+def test_a_state_feedback_object_acts_in_the_design_points_basis():
+    """The designed LQR given as an object gives the loads of its spec at another altitude."""
+    sc = load_scenario("scenarios/goland_aileron_lqr.toml")
+    kw = dict(
+        sensors=(),
+        outputs=("tip_disp",),
+        design_speed_factor=1.1,
+        points=(FlightPoint(6000.0, 90.0, "V_C", "nominal"),),
+        n_gradients=4,
+    )
+    spec = _study(controller=sc.controller, **kw)
+    ctrl, _ = design_point(spec)
+    obj = _study(controller=ctrl, limits=sc.controller.limits, **kw)
+    a, b = run_gust_loads(spec).table, run_gust_loads(obj).table
+    assert np.allclose(a["discrete_max"], b["discrete_max"], rtol=1e-9)

@@ -28,6 +28,7 @@ EXPECTED = {
     "05_flutter_clearance.ipynb",
     "06_sensitivities_and_tailoring.ipynb",
     "07_bring_your_own_controller.ipynb",
+    "08_gust_loads.ipynb",
 }
 KERNEL = "python3"
 

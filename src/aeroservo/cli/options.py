@@ -297,13 +297,19 @@ def run_into_folder(scenario, args: argparse.Namespace):
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out = {args.out!r}: is a file, expected a folder")
+    made = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
-    run = run_scenario(
-        scenario,
-        out,
-        progress=progress,
-        scheduler=getattr(args, "scheduler", None),
-        workers=getattr(args, "workers", None),
-    )
-    return run, write_run(run, out)
+    try:
+        run = run_scenario(
+            scenario,
+            out,
+            progress=progress,
+            scheduler=getattr(args, "scheduler", None),
+            workers=getattr(args, "workers", None),
+        )
+        return run, write_run(run, out)
+    except BaseException:
+        if made and out.is_dir() and not any(out.iterdir()):  # a failed run leaves nothing
+            out.rmdir()
+        raise

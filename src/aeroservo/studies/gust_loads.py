@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aero.atmosphere import isa, tas_from_eas
-from ..aero.gust_rules import flight_profile_alleviation
+from ..aero.gust_rules import GRADIENT_RANGE, flight_profile_alleviation
 from ..errors import InputError, check_int, check_number
 from ..system.damping import NO_DAMPING, StructuralDamping
 
@@ -232,7 +232,9 @@ _DESIGNED: dict = {}
 
 def design_point(study: GustLoadsStudy):
     """``(controller, state_scaling)``: the study's controller (a spec designed at the design
-    point) and the plant state scaling it was designed in (None for an object)."""
+    point) and the plant state scaling a state feedback acts in: that of the design point's
+    plant (for a state-feedback object too, which must have been designed on the balanced
+    states of ``study.loop(design_mass_case, design_density)``); None for output feedback."""
     from ..design.spec import ControllerSpec
 
     key = id(study)
@@ -254,7 +256,12 @@ def design_point(study: GustLoadsStudy):
                 )
             speed = study.design_speed_factor * vf
         ctrl = loop.design_controller(ctrl, speed, study.sample_rate, vf)
-        scaling = loop.plant_builder.state_scaling
+        needs = getattr(ctrl, "needs_state", False) or hasattr(ctrl, "state_map")
+        scaling = loop.plant_builder.state_scaling if needs else None
+    elif ctrl is not None and getattr(ctrl, "needs_state", False):
+        # a state-feedback object acts on the balanced states of the design point's plant
+        case = study.design_mass_case or next(iter(study.mass_cases))
+        scaling = study.loop(case, study.design_density).plant_builder.state_scaling
     _DESIGNED.clear()
     _DESIGNED[key] = (study, (ctrl, scaling))
     return ctrl, scaling
@@ -307,6 +314,14 @@ def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
     if study.controller is not None:
         ctrl, reference = design_point(study)
         loops["closed"] = (ctrl, reference)
+        w_dt = np.pi * v / GRADIENT_RANGE[0] * float(ctrl.dt)  # shortest gust x sample period
+        if w_dt > 0.1:
+            res.notes.append(
+                f"the controller samples at {1 / float(ctrl.dt):.4g} Hz, coarse against the "
+                f"shortest gust ({2 * GRADIENT_RANGE[0] / v:.3g} s): the closed loop is marched "
+                "and its loads read at that rate, so closed-vs-open differences of a few % are "
+                "within its error"
+            )
     for name, spec in loops.items():
         if spec is None and not res.open_loop_stable:
             res.notes.append(
@@ -317,6 +332,13 @@ def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
         sys, kw = plant, {}
         if spec is not None:
             ctrl, reference = spec
+            if reference is not None and reference.size != loop.plant_builder.n_states:
+                raise InputError(
+                    f"mass case {point.mass_case!r}: its model has {loop.plant_builder.n_states}"
+                    f" states, the state-feedback controller was designed on {reference.size}"
+                    " (another control-surface layout or mesh): a state feedback cannot be "
+                    "carried to it; give that mass case the design case's surfaces"
+                )
             sys = in_state_basis(plant, loop.plant_builder.state_scaling, reference)
             limits = study.limits or getattr(study.controller, "limits", None)
             kw = dict(controller=ctrl, delay=study.delay)

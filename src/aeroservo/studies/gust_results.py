@@ -195,12 +195,10 @@ class GustLoadsResult:
         t = self.table
         t = t[t["loop"] == loop]
         rows = t.loc[t.groupby("load", sort=False)["limit"].idxmax()]
+        turb = rows["turbulence"] > rows[["discrete_max", "discrete_min"]].abs().max(axis=1)
+        linear = "turbulence (linear loop; the actuator saturates in the gusts)"
         rows = rows.assign(
-            source=np.where(
-                rows["turbulence"] > rows[["discrete_max", "discrete_min"]].abs().max(axis=1),
-                "turbulence",
-                "discrete",
-            )
+            source=np.where(turb, np.where(rows["saturated"] > 0, linear, "turbulence"), "discrete")
         )
         return rows.set_index("load")
 
@@ -251,6 +249,8 @@ class GustLoadsResult:
                 for what in ("discrete", "turbulence")
                 if np.isfinite(row[f"{what}_alleviation_pct"])
             ]
+            if not parts:  # open-loop load zero
+                parts = [f"{load} is zero open loop and {row['discrete_closed']:.4g} closed"]
             lines.append(f"the loop raises {load} at {_point_label(rec)}: " + ", ".join(parts))
         return lines
 

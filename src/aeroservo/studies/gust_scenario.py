@@ -140,7 +140,8 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
         "kind": "gust_loads",
         "result": result.name,
         "mass_cases": dict(result.settings.get("mass_cases", {})),
-        "n_points": len({r["point"] for r in result.records}),
+        "n_points": len(result.settings.get("points", []))
+        or len({r["point"] for r in result.records}),
         "loops": result.loops,
         "worst": worst,
         "raised_loads": result.raised_loads(),
@@ -150,7 +151,12 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
                 for r in result.records
                 for note in r["notes"]
             }.values()
-        ),
+        )
+        + [
+            {"point": k["point"], "flight_point": k["flight_point"], "note": f"no loads: {n}"}
+            for k in result.settings.get("skipped_points", [])
+            for n in k["notes"]
+        ],
         "saturation": [
             {"point": r["point"], "flight_point": _label(r), "loop": r["loop"], **r["limited"]}
             for r in result.records
