@@ -12,7 +12,8 @@ from ..aero.atmosphere import isa_at_density
 from ..errors import RANGES, InputError, check_number
 from ..system.first_order import mach_note
 from .signals import Sensor, describe
-from .state_space import DENSITIES, MAX_SPEED, Servo, StateSpaceBuilder, _tag
+from .state_space import DENSITIES, MAX_SPEED, Servo, StateSpaceBuilder
+from .tags import tag
 
 __all__ = ["statespace", "statespace_family", "discretize", "tip_deflection_state"]
 
@@ -166,7 +167,7 @@ def discretize(sys, sample_rate: float):
     rate = check_number("sample_rate", sample_rate, unit="Hz", lo=lo, hi=hi)
     d = sys.sample(1.0 / rate, method="zoh")
     if hasattr(sys, "speed"):
-        _tag(d, sys.speed, sys.density, sys.signal_units)
+        tag(d, sys.speed, sys.density, sys.signal_units)
     if hasattr(sys, "state_scaling"):
         d.state_scaling = sys.state_scaling
     return d

@@ -8,6 +8,7 @@ Inputs (by name; ``<s>`` is a control-surface name):
 * ``<s>_command`` [rad] - commanded surface rotation: the actuator springs pull the surface
   towards the (servo-filtered) command, ``k_act (delta_c - delta(x_a))`` at each actuator.
 * ``gust`` [m/s] - vertical gust velocity, positive up, uniform along the span.
+* ``<a>_nonlinear_moment`` [N m] - moment at actuator ``<a>`` alone (a nonlinear hinge's).
 
 Outputs (by name, or :class:`Sensor` for any point):
 
@@ -15,6 +16,7 @@ Outputs (by name, or :class:`Sensor` for any point):
   - vertical motion at the tip leading edge, trailing edge and elastic axis;
 * ``tip_twist`` [rad], ``tip_twist_rate`` [rad/s];
 * ``<s>_deflection`` [rad], ``<s>_rate`` [rad/s] - span-averaged surface rotation;
+  ``<a>_rotation`` [rad], ``<a>_rotation_rate`` [rad/s] - at the station of actuator ``<a>``;
 * ``<s>_aero_hinge_moment`` [N m] - aerodynamic moment about the hinge, integrated over the span
   of the surface, positive trailing-edge down;
 * ``<s>_actuator_moment`` [N m] - moment the actuators (and the hinge-moment input) exert on
@@ -100,9 +102,10 @@ class Sensor:
 @dataclass(frozen=True)
 class InputDef:
     name: str
-    kind: str  # "hinge_moment" | "command" | "gust"
+    kind: str  # "hinge_moment" | "command" | "gust" | "element"
     surface: int | None
     unit: str
+    actuator: int | None = None
 
 
 @dataclass(frozen=True)
@@ -124,6 +127,9 @@ def input_names(wing) -> dict[str, InputDef]:
         )
         if cs.actuators:
             out[f"{cs.name}_command"] = InputDef(f"{cs.name}_command", "command", k, "rad")
+        for j, a in enumerate(cs.actuators):
+            name = f"{a.name}_nonlinear_moment"
+            out[name] = InputDef(name, "element", k, "N m", actuator=j)
     out["gust"] = InputDef("gust", "gust", None, "m/s")
     return out
 
@@ -200,6 +206,11 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
         specs = [specs]
     specs = check_names("outputs", specs, items=(str, Sensor))
     surfaces = {cs.name: k for k, cs in enumerate(wing.control_surfaces)}
+    actuators = {
+        a.name: (k, j)
+        for k, cs in enumerate(wing.control_surfaces)
+        for j, a in enumerate(cs.actuators)
+    }
     out = []
     for spec in specs:
         if isinstance(spec, Sensor):
@@ -241,6 +252,14 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
                 )
             out.append(OutputDef(spec, "modal", "kg^0.5 m", index=k - 1))
             continue
+        name, _, rate = spec.partition("_rotation")
+        if name in actuators and rate in ("", "_rate"):
+            k, j = actuators[name]
+            kind, unit = (
+                ("actuator_rotation", "rad") if not rate else ("actuator_rotation_rate", "rad/s")
+            )
+            out.append(OutputDef(spec, kind, unit, surface=k, index=j))
+            continue
         for suffix, kind, unit in (
             ("_deflection", "deflection", "rad"),
             ("_rate", "rate", "rad/s"),
@@ -262,6 +281,7 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
                     "modal_<k>",
                 ]
                 + [f"{s}_{{deflection,rate,aero_hinge_moment,actuator_moment}}" for s in surfaces]
+                + [f"{a}_rotation[_rate]" for a in actuators]
             )
             raise InputError(
                 f"output {describe(spec)}: unknown sensor; known outputs: {names}, or a Sensor"

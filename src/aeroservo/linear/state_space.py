@@ -14,7 +14,6 @@ dynamics). Signals, units and sign conventions: :mod:`aeroservo.linear.signals` 
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -38,6 +37,7 @@ from .signals import (
     surface_mean_row,
     surface_unit,
 )
+from .tags import system_name, tag
 
 __all__ = ["Servo", "StateSpaceBuilder", "MAX_SPEED", "DENSITIES"]
 
@@ -210,6 +210,8 @@ class StateSpaceBuilder:
             k = d.surface
             if d.kind == "hinge_moment":
                 B[0, iv, j] += vec(hinge_moment_vector(model, k))
+            elif d.kind == "element":  # a moment at one actuator (a nonlinear hinge's)
+                B[0, iv, j] += vec(actuator_rows(model, k)[d.actuator][1])
             elif d.kind == "command":
                 force = vec(sum(ka * r for ka, r in actuator_rows(model, k)))
                 sv = self.servos[k]
@@ -259,6 +261,9 @@ class StateSpaceBuilder:
                     Cacc[i] = row
             elif o.kind == "deflection":
                 Cx[0, i, iq] = vec(surface_mean_row(model, o.surface))
+            elif o.kind in ("actuator_rotation", "actuator_rotation_rate"):
+                rows = iq if o.kind == "actuator_rotation" else iv
+                Cx[0, i, rows] = vec(actuator_rows(model, o.surface)[o.index][1])
             elif o.kind == "rate":
                 Cx[0, i, iv] = vec(surface_mean_row(model, o.surface))
             elif o.kind == "modal":
@@ -276,7 +281,7 @@ class StateSpaceBuilder:
                 for d in self.inputs:
                     if d.surface != k:
                         continue
-                    if d.kind == "hinge_moment":
+                    if d.kind in ("hinge_moment", "element"):
                         Du[0, i, col[d.name]] = 1.0
                     elif d.kind == "command" and self.servos[k].order == 0:
                         Du[0, i, col[d.name]] = k_tot
@@ -356,9 +361,9 @@ class StateSpaceBuilder:
             states=list(self.state_labels),
             inputs=list(self.input_labels),
             outputs=list(self.output_labels),
-            name=_system_name(self.model.wing.name, float(speed)),
+            name=system_name(self.model.wing.name, float(speed)),
         )
-        _tag(sys, float(speed), self.density, self.units)
+        tag(sys, float(speed), self.density, self.units)
         sys.state_scaling = s
         return sys
 
@@ -380,18 +385,6 @@ class StateSpaceBuilder:
             for i, v in enumerate(speeds)
         ]
         return [self.at(v, balanced=balanced) for v in vs]
-
-
-def _system_name(wing_name: str, speed: float) -> str:
-    """python-control system name (no dots allowed): e.g. ``goland_wing_V137p4``."""
-    slug = re.sub(r"\W+", "_", wing_name).strip("_").lower() or "wing"
-    return f"{slug}_V{speed:.6g}".replace(".", "p").replace("-", "m")
-
-
-def _tag(sys, speed: float, density: float, units: dict) -> None:
-    sys.speed = speed
-    sys.density = density
-    sys.signal_units = dict(units)
 
 
 def _block_inverse_dense(system, n0: int) -> np.ndarray:

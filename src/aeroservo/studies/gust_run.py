@@ -4,9 +4,7 @@ progress bar, like a trade study (:mod:`aeroservo.studies.trade.workers`)."""
 
 from __future__ import annotations
 
-import contextlib
 import time
-import warnings
 
 from ..errors import InputError, check_int
 from .gust_loads import GustLoadsStudy, PointLoads, design_point, evaluate_point
@@ -111,30 +109,14 @@ def run_gust_loads(
 
 
 def _on_dask(study, points, workers, scheduler, timeout, bar) -> list[PointLoads]:
-    from distributed import as_completed
+    from .trade.workers import map_tasks
 
-    from .trade.workers import LostWorkers, check_address, connect, local_cluster
-
-    results: dict[int, PointLoads] = {}
-    with contextlib.ExitStack() as stack:
-        if scheduler is None:
-            address = stack.enter_context(local_cluster(workers, timeout=timeout)).scheduler_address
-        else:
-            address = check_address(scheduler)
-        client = connect(stack, address, 5.0, 10.0)
-        keys = [f"gust-loads-{study.name}-{i}-{time.time_ns()}" for i in range(len(points))]
-        lost = LostWorkers(client, keys)
-        [study_f] = client.scatter([study], broadcast=True)
-        futures = client.map(evaluate_point, [study_f] * len(points), points, key=keys, pure=False)
-        index = {f.key: i for i, f in enumerate(futures)}
-        try:
-            for fut, res in as_completed(futures, with_results=True, raise_errors=False):
-                if fut.status != "finished":
-                    raise RuntimeError(f"flight point {points[index[fut.key]].label}: {res!r}")
-                results[index[fut.key]] = res
-                for note in lost.notes():
-                    warnings.warn(note, UserWarning, stacklevel=3)
-                bar.update(1)
-        finally:
-            client.cancel([f for f in futures if not f.done()])
-    return [results[i] for i in range(len(points))]
+    try:
+        return map_tasks(
+            evaluate_point, study, points, workers=workers, scheduler=scheduler,
+            timeout=timeout, bar=bar, what=f"gust-loads-{study.name}",
+        )  # fmt: skip
+    except RuntimeError as exc:  # name the flight point
+        head, _, rest = str(exc).partition(": ")
+        i = int(head.rsplit(" ", 1)[-1])
+        raise RuntimeError(f"flight point {points[i].label}: {rest}") from None

@@ -240,20 +240,23 @@ def _unit(i: int) -> np.ndarray:
 
 def actuator_stiffness(wing: Wing, mesh: Mesh, n_q: int) -> sp.csr_matrix:
     """Point springs k_act delta_D(x - x_a) acting on the flap rotation of their surface."""
-    rows, cols, vals = [], [], []
-    for k, cs in enumerate(wing.control_surfaces):
-        own = np.flatnonzero(mesh.surface == k)
+    k = sp.csr_matrix((n_q, n_q))
+    for i, cs in enumerate(wing.control_surfaces):
         for act in cs.actuators:
-            x = act.station
-            i = np.searchsorted(mesh.nodes[own + 1], x - 1e-12 * wing.span)
-            e = own[min(i, own.size - 1)]
-            xi = (x - mesh.nodes[e]) / (mesh.nodes[e + 1] - mesh.nodes[e])
-            n, _ = point_shapes(mesh.lengths[e], float(np.clip(xi, 0.0, 1.0)))
-            nd = n[2, 6:8]
-            dofs = mesh.element_dofs[e, 6:8]
-            for i in range(2):
-                for j in range(2):
-                    rows.append(dofs[i])
-                    cols.append(dofs[j])
-                    vals.append(act.stiffness * nd[i] * nd[j])
-    return sp.coo_matrix((vals, (rows, cols)), shape=(n_q, n_q)).tocsr()
+            r = actuator_row(wing, mesh, n_q, i, act)
+            k = k + act.stiffness * sp.csr_matrix(np.outer(r, r))
+    return k
+
+
+def actuator_row(wing: Wing, mesh: Mesh, n_q: int, surface: int, act) -> np.ndarray:
+    """The row ``r`` with ``delta(x_a) = r @ q``: the rotation of control surface number
+    ``surface`` at the station of its actuator ``act`` [rad per unit of the unknowns]."""
+    own = np.flatnonzero(mesh.surface == surface)
+    x = act.station
+    i = np.searchsorted(mesh.nodes[own + 1], x - 1e-12 * wing.span)
+    e = own[min(i, own.size - 1)]
+    xi = (x - mesh.nodes[e]) / (mesh.nodes[e + 1] - mesh.nodes[e])
+    n, _ = point_shapes(mesh.lengths[e], float(np.clip(xi, 0.0, 1.0)))
+    r = np.zeros(n_q)
+    r[mesh.element_dofs[e, 6:8]] = n[2, 6:8]
+    return r

@@ -283,3 +283,38 @@ def quiet_distributed(stack: contextlib.ExitStack) -> None:
     run's shutdown logs a warning for every task cancelled in flight."""
     saved = _silence(logging.CRITICAL + 1)
     stack.callback(lambda: [lg.setLevel(level) for lg, level in saved])
+
+
+def map_tasks(fn, shared, items: list, *, workers: int, scheduler, timeout: float, bar, what: str):
+    """``[fn(shared, item) for item in items]`` on Dask (a local cluster of ``workers``
+    processes, or the running scheduler at ``scheduler``), in order, ``bar`` updated as each
+    finishes; a failed task raises a RuntimeError naming ``what`` and the item's index."""
+    import contextlib
+    import time
+    import warnings
+
+    from distributed import as_completed
+
+    results: dict = {}
+    with contextlib.ExitStack() as stack:
+        if scheduler is None:
+            address = stack.enter_context(local_cluster(workers, timeout=timeout)).scheduler_address
+        else:
+            address = check_address(scheduler)
+        client = connect(stack, address, 5.0, 10.0)
+        keys = [f"{what}-{i}-{time.time_ns()}" for i in range(len(items))]
+        lost = LostWorkers(client, keys)
+        [shared_f] = client.scatter([shared], broadcast=True)
+        futures = client.map(fn, [shared_f] * len(items), items, key=keys, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for fut, res in as_completed(futures, with_results=True, raise_errors=False):
+                if fut.status != "finished":
+                    raise RuntimeError(f"{what} {index[fut.key]}: {res!r}")
+                results[index[fut.key]] = res
+                for note in lost.notes():
+                    warnings.warn(note, UserWarning, stacklevel=3)
+                bar.update(1)
+        finally:
+            client.cancel([f for f in futures if not f.done()])
+    return [results[i] for i in range(len(items))]

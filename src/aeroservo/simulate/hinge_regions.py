@@ -1,0 +1,324 @@
+"""Piecewise-linear hinges: the linear system of each region and exact motion through switches.
+
+While every element stays on one piece of its law (a *region*), the plant is linear and affine,
+``x' = A_r x + B u + g_r`` with ``A_r = A + B_n K_r C_n`` and ``g_r = B_n f_r``
+(``phi = K_r s + f_r`` on the pieces). Between samples the input is held, so the motion is
+known in closed form from the eigen-decomposition ``A_r = V diag(lambda) V^-1``:
+
+    y(t) = exp(lambda t) y0 + (exp(lambda t) - 1) / lambda * gamma,   x = V y,
+
+and the time a rotation reaches an edge of its piece is the root of a scalar function, located
+by Brent's method to rounding (``docs/freeplay.md``). Region matrices are built once per region
+visited and cached.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import brentq
+
+from ..design.plant import zoh
+from ..errors import InputError
+
+__all__ = ["Regions", "piece_tables", "leaves"]
+
+_SUB = 24
+"""Sub-intervals on which a flagged sample interval is scanned for edge crossings."""
+
+
+def piece_tables(elements) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per element ``(edges, K, f)`` with ``phi = K[i] s + f[i]`` on piece ``i``; pieces
+    with the same moment on both sides of an edge are merged (a zero gap has no edge)."""
+    out = []
+    for k, law in zip(elements.stiffness, elements.laws, strict=True):
+        edges, slopes, icpt = law.pieces(k)
+        K, f = k - slopes, -icpt
+        # drop empty pieces (a zero gap), then merge neighbours with the same moment
+        keep = [0] + [
+            i + 1 for i in range(edges.size) if i + 1 == edges.size or edges[i + 1] > edges[i]
+        ]
+        pieces = [p for p in range(K.size) if p in keep]
+        keep_e, keep_p = [], [pieces[0]]
+        for p in pieces[1:]:
+            if K[p] == K[keep_p[-1]] and f[p] == f[keep_p[-1]]:
+                continue
+            keep_e.append(edges[p - 1])
+            keep_p.append(p)
+        out.append((np.array(keep_e), K[keep_p], f[keep_p]))
+    return out
+
+
+class Regions:
+    """Region matrices of a nonlinear plant sampled at ``dt`` (cached per region)."""
+
+    def __init__(self, nplant, B: np.ndarray, C: np.ndarray, D_d: np.ndarray, dt: float):
+        self.np = nplant
+        self.A = np.asarray(nplant.plant.A)
+        self.B, self.C, self.dt = B, C, dt
+        self.d_n = D_d  # feedthrough of phi to the outputs C reads
+        self.tables = piece_tables(nplant.elements)
+        self.scale = np.array([max(np.ptp(t[0]) if t[0].size else 0.0, 1e-6) for t in self.tables])
+        self._sampled: dict = {}
+        self._eigen: dict = {}
+
+    def locate(self, s: np.ndarray) -> tuple:
+        """The region (piece index per element) of the rotations ``s`` [rad]."""
+        return tuple(
+            int(np.searchsorted(t[0], v, side="right")) for t, v in zip(self.tables, s, strict=True)
+        )
+
+    def bounds(self, r: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper edges of region ``r`` per element (+-inf at the ends)."""
+        lo = np.array(
+            [t[0][i - 1] if i > 0 else -np.inf for t, i in zip(self.tables, r, strict=True)]
+        )
+        hi = np.array(
+            [t[0][i] if i < t[0].size else np.inf for t, i in zip(self.tables, r, strict=True)]
+        )
+        return lo, hi
+
+    def affine(self, r: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """``(K_r, f_r)``: ``phi = K_r s + f_r`` on region ``r``."""
+        K = np.array([t[1][i] for t, i in zip(self.tables, r, strict=True)])
+        f = np.array([t[2][i] for t, i in zip(self.tables, r, strict=True)])
+        return K, f
+
+    def system(self, r: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A_r, g_r, C_r, e_r)``: state matrix, affine term, output matrix and output
+        constant of region ``r`` (outputs ``C x + D_n phi``)."""
+        K, f = self.affine(r)
+        p = self.np
+        A = self.A + (p.b_n * K) @ p.c_n
+        C = self.C + (self.d_n * K) @ p.c_n
+        return A, p.b_n @ f, C, self.d_n @ f
+
+    def sampled(self, r: tuple):
+        """``(Phi, Gu, g, C_r, e_r)`` of region ``r`` over one sample (zero-order hold)."""
+        if r not in self._sampled:
+            A, g, C, e = self.system(r)
+            Phi, G = zoh(A, np.hstack([self.B, g[:, None]]), self.dt)
+            self._sampled[r] = (Phi, G[:, :-1], G[:, -1], C, e)
+        return self._sampled[r]
+
+    def eigen(self, r: tuple):
+        """``(lambda, V, V^-1, V^-1 [B g], C_n V, C_rate V)`` of region ``r``."""
+        if r not in self._eigen:
+            A, g, _, _ = self.system(r)
+            lam, V = sla.eig(A)
+            Vi = np.linalg.inv(V)
+            err = np.linalg.norm(V @ (lam[:, None] * Vi) - A, 1) / max(np.linalg.norm(A, 1), 1.0)
+            if not err < 1e-8:
+                raise InputError(
+                    f"nonlinear march: the linear system of region {r} is defective (eigen-"
+                    f"decomposition residual {err:.1e}); it cannot be marched exactly"
+                )
+            G = Vi @ np.hstack([self.B, g[:, None]])
+            self._eigen[r] = (lam, V, Vi, G, self.np.c_n @ V, self.np.c_rate @ V)
+        return self._eigen[r]
+
+    def interval(self, x: np.ndarray, r: tuple, u: np.ndarray, h: float, switches: list, t0: float):
+        """March ``h`` [s] from ``x`` in region ``r`` with the input ``u`` held, through every
+        edge crossing: ``(x_end, region_end)``; crossing times [s] (from ``t0``) are appended to
+        ``switches``.
+
+        The interval is scanned at :data:`_SUB` points; a sub-interval where a rotation is
+        beyond an edge of its piece, or where the cubic Hermite interpolant of the rotation and
+        its rate predicts an excursion beyond it (a graze between two points), is scanned
+        finer; the crossing is then located by Brent's method on the closed-form rotation.
+        """
+        t = 0.0
+        for _ in range(10_000):
+            lam, V, Vi, G, W, Wd = self.eigen(r)[:6]
+            y0, gam = Vi @ x, G @ np.append(u, 1.0)
+            rest = h - t
+            lo, hi = self.bounds(r)
+            tol = 1e-12 * self.scale
+            bracket = self._quick(r, y0, gam, rest, lo - tol, hi + tol)
+            if bracket is None:  # no edge reached: the end of the interval
+                return _state(V, lam, y0, gam, rest), r
+            if not bracket:  # scan the interval
+                taus = np.linspace(0.0, rest, _SUB + 1)
+                Y = _path(lam, y0, gam, taus)
+                s = (W @ Y).real
+                bracket = _first_exit(s, taus, lo, hi, tol)
+                if bracket is None:
+                    j = _graze(s, (Wd @ Y).real, taus, lo, hi, tol)
+                    if j is not None:
+                        fine = np.linspace(taus[j - 1], taus[j], 257)
+                        bracket = _first_exit(_rot(W, lam, y0, gam, fine), fine, lo, hi, tol)
+                if bracket is None:
+                    return (V @ Y[:, -1]).real, r
+            ta, tb, e, upper = bracket
+            edge = hi[e] if upper else lo[e]
+            gap = _scalar(W[e], lam, y0, gam, edge)
+            fa, fb = gap(ta), gap(tb)
+            tc = (
+                ta
+                if fa == 0.0 or np.sign(fa) == np.sign(fb)
+                else brentq(gap, ta, tb, xtol=1e-15, rtol=1e-15)
+            )
+            x = _state(V, lam, y0, gam, tc)
+            t += tc
+            switches.append(t0 + t)
+            r = r[:e] + (r[e] + (1 if upper else -1),) + r[e + 1 :]
+            if t >= h * (1.0 - 1e-14):
+                return x, r
+        raise InputError("nonlinear march: more than 10000 switches in one sample (chattering)")
+
+    def _wwd(self, r):
+        """``[C_n V; C_rate V]`` of region ``r``."""
+        ent = self.eigen(r)
+        if len(ent) == 6:
+            self._eigen[r] = ent = ent + (np.vstack([ent[4], ent[5]]),)
+        return ent[6]
+
+    def _quick(self, r, y0, gam, rest, lo, hi):
+        """From the ends of the interval alone: None when no rotation reaches an edge (none
+        ends beyond one, none turns beyond one by its cubic Hermite interpolant); the bracket
+        ``(0, rest, element, upper)`` when exactly one rotation ends beyond an edge with at most
+        one turning point on the way (one crossing); False otherwise (scan the interval)."""
+        lam, V, Vi, G, W, Wd = self.eigen(r)[:6]
+        e = W.shape[0]
+        Y = _path(lam, y0, gam, np.array([0.0, rest]))
+        S = (self._wwd(r) @ Y).real
+        v0, v1 = S[:, 0].tolist(), S[:, 1].tolist()
+        lo_l, hi_l = lo.tolist(), hi.tolist()
+        if not leaves(v0, v1, e, lo_l, hi_l, rest):
+            return None
+        out = [j for j in range(e) if not lo_l[j] <= v1[j] <= hi_l[j]]
+        if len(out) != 1:
+            return False
+        j = out[0]
+        if _turns(v0[j], v1[j], v0[e + j] * rest, v1[e + j] * rest) > 1:
+            return False
+        for i in range(e):  # the others must not graze an edge
+            if i != j and leaves(
+                [v0[i], v0[e + i]], [v1[i], v1[e + i]], 1, [lo_l[i]], [hi_l[i]], rest
+            ):
+                return False
+        return 0.0, rest, j, v1[j] > hi_l[j]
+
+
+def _turns(s0: float, s1: float, r0: float, r1: float) -> int:
+    """Turning points in (0, 1) of the cubic Hermite interpolant with end values ``s0, s1`` and
+    end slopes ``r0, r1`` (per unit of the interval)."""
+    a = 3.0 * (s1 - s0) - 2.0 * r0 - r1
+    b = 2.0 * (s0 - s1) + r0 + r1
+    qa, qb, qc = 3.0 * b, 2.0 * a, r0
+    if qa == 0.0:
+        return int(qb != 0.0 and 0.0 < -qc / qb < 1.0)
+    disc = qb * qb - 4.0 * qa * qc
+    if disc < 0.0:
+        return 0
+    sq = disc**0.5
+    return sum(0.0 < t < 1.0 for t in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)))
+
+
+def _first_exit(s, taus, lo, hi, tol):
+    """``(t_a, t_b, element, upper)`` of the first sample beyond an edge (not the first; upper:
+    beyond the upper edge), or None."""
+    below = s < (lo - tol)[:, None]
+    above = s > (hi + tol)[:, None]
+    out = below | above
+    out[:, 0] = False
+    cols = np.flatnonzero(out.any(axis=0))
+    if cols.size == 0:
+        return None
+    j = int(cols[0])
+    e = int(np.flatnonzero(out[:, j])[0])
+    return taus[j - 1], taus[j], e, not below[e, j]
+
+
+def _scalar(w, lam, y0, gam, edge):
+    """``tau -> w y(tau) - edge`` (real) for Brent's method: ``exp(lambda tau) (y0 +
+    gamma/lambda) - gamma/lambda`` when no eigenvalue is near zero, else the general form."""
+    if np.all(np.abs(lam) > 1e-6):
+        off = gam / lam
+        wa, c0 = w * (y0 + off), float((w @ off).real) + edge
+
+        def f(tau):
+            return float((wa @ np.exp(lam * tau)).real) - c0
+
+        return f
+    w2 = w[None, :]
+    return lambda tau: _rot(w2, lam, y0, gam, np.array([tau]))[0, 0] - edge
+
+
+def _phi1(lam: np.ndarray, taus: np.ndarray) -> np.ndarray:
+    """``(exp(lambda tau) - 1) / lambda`` (tau where lambda tau is tiny), (n, n_tau)."""
+    z = lam[:, None] * taus[None, :]
+    small = np.abs(z) < 1e-8
+    safe = np.where(lam == 0, 1.0, lam)[:, None]
+    return np.where(small, taus[None, :] * (1.0 + 0.5 * z), np.expm1(z) / safe)
+
+
+def _path(lam, y0, gam, taus) -> np.ndarray:
+    """Modal coordinates ``y(tau) = exp(lambda tau) y0 + phi1(lambda, tau) gamma``, (n, n_tau);
+    as ``exp(lambda tau) (y0 + gamma/lambda) - gamma/lambda`` when no eigenvalue is near 0."""
+    ex = np.exp(np.multiply.outer(lam, taus))
+    if np.abs(lam).min() > 1e-6:
+        off = gam / lam
+        return ex * (y0 + off)[:, None] - off[:, None]
+    return ex * y0[:, None] + _phi1(lam, taus) * gam[:, None]
+
+
+def _rot(W, lam, y0, gam, taus) -> np.ndarray:
+    """Rows of ``W y(tau)`` (real)."""
+    return (W @ _path(lam, y0, gam, taus)).real
+
+
+def _state(V, lam, y0, gam, tau: float) -> np.ndarray:
+    return _rot(V, lam, y0, gam, np.array([tau]))[:, 0]
+
+
+def _graze(s, sd, taus, lo, hi, tol):
+    """Index of the first sub-interval whose cubic Hermite interpolant of a rotation (from its
+    values and rates at the ends) leaves the piece, or None."""
+    dt = np.diff(taus)
+    th = np.linspace(0.0, 1.0, 33)[:, None]
+    h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+    h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+    first = None
+    for e in range(s.shape[0]):
+        d0, d1 = sd[e, :-1] * dt, sd[e, 1:] * dt
+        turn = np.flatnonzero(d0 * d1 < 0)
+        if turn.size == 0:
+            continue
+        p = h00 * s[e, turn] + h10 * d0[turn] + h01 * s[e, turn + 1] + h11 * d1[turn]
+        bad = ((p < lo[e] - tol[e]) | (p > hi[e] + tol[e])).any(axis=0)
+        if bad.any():
+            j = int(turn[np.flatnonzero(bad)[0]]) + 1
+            first = j if first is None else min(first, j)
+    return first
+
+
+def leaves(v0, v1, e, lo, hi, dt) -> bool:
+    """Whether a rotation ends the sample beyond an edge of its piece, or turns within the
+    sample (rates of opposite signs at the ends) and its cubic Hermite interpolant reaches
+    beyond an edge (a graze). Python floats: ``e`` is a handful of elements."""
+    for j in range(e):
+        s1 = v1[j]
+        if s1 < lo[j] or s1 > hi[j]:
+            return True
+        d0, d1 = v0[e + j] * dt, v1[e + j] * dt
+        if d0 * d1 < 0.0:
+            s0 = v0[j]
+            # p(t) = s0 + d0 t + a t^2 + b t^3 on [0, 1]; p'(t) = 0 at the turning point
+            a = 3.0 * (s1 - s0) - 2.0 * d0 - d1
+            b = 2.0 * (s0 - s1) + d0 + d1
+            qa, qb, qc = 3.0 * b, 2.0 * a, d0
+            if qa == 0.0:
+                roots = [-qc / qb] if qb else []
+            else:
+                disc = qb * qb - 4.0 * qa * qc
+                if disc < 0.0:
+                    continue
+                sq = disc**0.5
+                roots = [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)]
+            for t in roots:
+                if 0.0 < t < 1.0:
+                    p = s0 + t * (d0 + t * (a + t * b))
+                    if p < lo[j] or p > hi[j]:
+                        return True
+    return False

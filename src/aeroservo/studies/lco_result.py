@@ -1,0 +1,205 @@
+"""The result of a limit-cycle study: the verdict of every march, the table, the summary.
+
+Amplitudes are those of the rotation of the reference element (the first nonlinear hinge):
+half its peak-to-peak over the settled window (``amplitude``) and its RMS about the window mean
+(``rms``) [rad], and both per total gap (``*_per_gap``). Figures: :mod:`.lco_plots`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["LCOResult", "TABLE_COLUMNS", "describing_lines"]
+
+TABLE_COLUMNS = (
+    "start",
+    "speed",
+    "initial",
+    "kind",
+    "confidence",
+    "frequency",
+    "amplitude",
+    "rms",
+    "mean",
+    "amplitude_per_gap",
+    "rms_per_gap",
+    "growth",
+    "switches_per_second",
+    "reason",
+)
+"""Columns of :meth:`LCOResult.table` (SI: m/s, rad, Hz, 1/s)."""
+
+
+class LCOResult:
+    """Verdicts of the marches of a study and the describing-function branches.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per march: ``start`` ("point", "up" or "down"), ``speed`` [m/s], ``initial``
+        rotation [rad], ``kind`` (lco, decay, divergence, aperiodic, undecided, failed),
+        ``confidence``, ``reason``, ``frequency`` [Hz], ``amplitude`` and ``rms`` [rad] of the
+        reference rotation, per gap, ``peaks``/``rmss`` of every recorded signal, and
+        ``history`` (the end of the march).
+    settings : dict
+        What was run (elements, laws, speeds, amplitudes, duration, controller, timing, notes).
+    branches : DescribingBranches or None
+    """
+
+    def __init__(self, rows: list, settings: dict, branches=None):
+        self.rows = list(rows)
+        self.settings = dict(settings)
+        self.branches = branches
+
+    def __repr__(self) -> str:
+        return (
+            f"LCOResult({self.settings.get('name', '')!r}, {len(self.rows)} marches, "
+            f"onset {self.onset():.4g} m/s)"
+        )
+
+    @property
+    def gap(self) -> float | None:
+        return self.settings.get("gap")
+
+    def table(self, start: str | None = None) -> list[dict]:
+        """Rows without histories (of one ``start`` kind if given)."""
+        return [
+            {k: r[k] for k in TABLE_COLUMNS}
+            for r in self.rows
+            if start is None or r["start"] == start
+        ]
+
+    def lco_rows(self) -> list[dict]:
+        """The marches that settled in a limit cycle."""
+        return [r for r in self.rows if r["kind"] == "lco"]
+
+    def onset(self) -> float:
+        """Lowest speed [m/s] where any march settled in a limit cycle (nan if none)."""
+        v = [r["speed"] for r in self.lco_rows()]
+        return float(min(v)) if v else float("nan")
+
+    def diverged_from(self) -> float:
+        """Lowest speed [m/s] where a march diverged (nan if none)."""
+        v = [r["speed"] for r in self.rows if r["kind"] == "divergence"]
+        return float(min(v)) if v else float("nan")
+
+    def hysteresis(self) -> list[float]:
+        """Speeds [m/s] where the up and down sweeps end in different states (one in a limit
+        cycle, the other not, or amplitudes differing by more than 5 %)."""
+        up = {r["speed"]: r for r in self.rows if r["start"] == "up"}
+        down = {r["speed"]: r for r in self.rows if r["start"] == "down"}
+        out = []
+        for v in sorted(set(up) & set(down)):
+            a, b = up[v], down[v]
+            if (a["kind"] == "lco") != (b["kind"] == "lco"):
+                out.append(v)
+            elif a["kind"] == "lco" and abs(a["amplitude"] - b["amplitude"]) > 0.05 * max(
+                a["amplitude"], b["amplitude"]
+            ):
+                out.append(v)
+        return out
+
+    def summary_text(self) -> str:
+        """A few lines a flutter engineer reads first."""
+        s = self.settings
+        gap = self.gap
+        lines = [
+            f"{s.get('name', 'lco')}: {len(self.rows)} marches of {s.get('duration', 0):g} s "
+            f"({s.get('controller', '')}), elements {', '.join(s.get('elements', []))}: "
+            f"{'; '.join(s.get('laws', []))}",
+        ]
+        lcos = self.lco_rows()
+        if lcos:
+            v = [r["speed"] for r in lcos]
+            amp = [r["amplitude_per_gap"] if gap else r["amplitude"] for r in lcos]
+            unit = "x gap" if gap else "rad"
+            lines.append(
+                f"limit cycles from {min(v):.4g} to {max(v):.4g} m/s, amplitude (half peak-to-"
+                f"peak of {s.get('reference')}) {min(amp):.3g} to {max(amp):.3g} {unit}, "
+                f"{min(r['frequency'] for r in lcos):.3g} to "
+                f"{max(r['frequency'] for r in lcos):.3g} Hz"
+            )
+        else:
+            lines.append("no settled limit cycle at any speed")
+        dv = self.diverged_from()
+        if np.isfinite(dv):
+            lines.append(f"divergent motion from {dv:.4g} m/s")
+        hyst = self.hysteresis()
+        if hyst:
+            lines.append(
+                "hysteresis (up and down sweeps differ) at "
+                + ", ".join(f"{v:.4g}" for v in hyst)
+                + " m/s"
+            )
+        other = [r for r in self.rows if r["kind"] in ("aperiodic", "undecided", "failed")]
+        if other:
+            lines.append(
+                f"{len(other)} marches not settled (aperiodic, undecided or failed): see the "
+                "table's reason column"
+            )
+        lines += describing_lines(self)
+        lines += list(s.get("notes", []))
+        return "\n".join(lines)
+
+    def plot(self, ax=None, **kw):
+        """The bifurcation diagram (:func:`.lco_plots.plot_bifurcation`)."""
+        from .lco_plots import plot_bifurcation
+
+        return plot_bifurcation(self, ax=ax, **kw)
+
+    def plot_histories(self, speeds=None, **kw):
+        """Example time histories (:func:`.lco_plots.plot_histories`)."""
+        from .lco_plots import plot_histories
+
+        return plot_histories(self, speeds=speeds, **kw)
+
+
+def describing_lines(result) -> list[str]:
+    """The describing-function prediction against the marches: where its stable limit cycles
+    (every other root damped) lie, and its amplitude and frequency at the speeds where the
+    marches settled in one."""
+    b = result.branches
+    if b is None or not len(b.speed):
+        return []
+    seen = b.stable & (b.others_stable if b.others_stable is not None else True)
+    if not seen.any():
+        return ["describing function: no stable limit cycle with every other root damped"]
+    lines = [
+        f"describing function: stable limit cycles (every other root damped) from "
+        f"{b.speed[seen].min():.4g} to {b.speed[seen].max():.4g} m/s, "
+        f"{b.frequency[seen].min():.3g}-{b.frequency[seen].max():.3g} Hz"
+    ]
+    errs = []
+    for r in result.lco_rows():
+        hit = _branch_at(b, seen, r["speed"], r["frequency"])
+        if hit is not None:
+            errs.append((hit[0] / r["amplitude"] - 1.0, hit[1] / r["frequency"] - 1.0))
+    if errs:
+        e = np.array(errs)
+        lines.append(
+            f"  against the {len(errs)} settled marches on such a branch (interpolated at their "
+            f"speed, frequency within 20 %): amplitude {100 * e[:, 0].min():+.1f} "
+            f"to {100 * e[:, 0].max():+.1f} %, frequency {100 * e[:, 1].min():+.1f} to "
+            f"{100 * e[:, 1].max():+.1f} %"
+        )
+    return lines
+
+
+def _branch_at(b, seen, speed: float, freq: float):
+    """``(amplitude, frequency)`` of a describing-function branch interpolated at ``speed``
+    between two neighbouring points (in amplitude) that are both seen, the one nearest in
+    frequency within 20 % of ``freq``; None if no branch passes there."""
+    best = None
+    for br in np.unique(b.branch):
+        idx = np.flatnonzero(b.branch == br)
+        idx = idx[np.argsort(b.amplitude[idx])]
+        for i, j in zip(idx[:-1], idx[1:], strict=True):
+            v0, v1 = b.speed[i], b.speed[j]
+            if not (seen[i] and seen[j]) or not min(v0, v1) <= speed <= max(v0, v1) or v0 == v1:
+                continue
+            w = (speed - v0) / (v1 - v0)
+            f = (1 - w) * b.frequency[i] + w * b.frequency[j]
+            a = (1 - w) * b.amplitude[i] + w * b.amplitude[j]
+            if abs(f / freq - 1.0) < 0.2 and (best is None or abs(f - freq) < abs(best[1] - freq)):
+                best = (a, f)
+    return best

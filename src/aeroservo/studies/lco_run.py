@@ -1,0 +1,134 @@
+"""Run a limit-cycle study: every march in this process or on Dask, with a progress bar, and
+the describing-function prediction of the open loop."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import InputError, check_int
+from .lco import LCOSetup, LCOSweep, march_task
+from .lco_result import LCOResult
+
+__all__ = ["run_lco"]
+
+
+def run_lco(
+    setup: LCOSetup,
+    sweep: LCOSweep,
+    *,
+    workers: int = 0,
+    scheduler: str | None = None,
+    progress: bool = False,
+    timeout: float = 60.0,
+    describing: bool = True,
+) -> LCOResult:
+    """March every point and sweep of ``sweep`` and judge each.
+
+    Parameters
+    ----------
+    setup : LCOSetup
+    sweep : LCOSweep
+    workers : int
+        0: in this process; N > 0: a local Dask cluster of N worker processes.
+    scheduler : str, optional
+        Address of a running Dask scheduler (overrides ``workers``).
+    progress : bool
+        A progress bar over the marches on stderr.
+    timeout : float
+        Time allowed for local workers to start [s].
+    describing : bool
+        Add the describing-function branches (open loop, gaps centred at zero).
+
+    Returns
+    -------
+    LCOResult
+    """
+    from tqdm import tqdm
+
+    if not isinstance(setup, LCOSetup):
+        raise InputError(f"setup = {setup!r}: expected an LCOSetup")
+    if not isinstance(sweep, LCOSweep):
+        raise InputError(f"sweep = {sweep!r}: expected an LCOSweep")
+    workers = check_int("workers", workers, lo=0, hi=256)
+    t0 = time.perf_counter()
+    tasks = sweep.tasks()
+    marches = sum(len(t[1]) for t in tasks)
+    bar = tqdm(total=len(tasks), desc=setup.name, unit="task", disable=not progress)
+    shared = (setup, sweep)
+    with bar:
+        if scheduler is None and workers == 0:
+            done = []
+            for task in tasks:
+                done.append(march_task(shared, task))
+                bar.update(1)
+        else:
+            from .trade.workers import map_tasks
+
+            done = map_tasks(
+                march_task, shared, tasks, workers=workers, scheduler=scheduler,
+                timeout=timeout, bar=bar, what=f"lco-{setup.name}",
+            )  # fmt: skip
+    rows = [r for rs in done for r in rs]
+    notes = []
+    branches = None
+    if describing:
+        branches, note = _describing(setup, sweep)
+        if note:
+            notes.append(note)
+    settings = {
+        "name": setup.name,
+        "density": setup.density,
+        "elements": list(setup.elements.names),
+        "laws": [law.describe() for law in setup.elements.laws],
+        "stiffness": setup.elements.stiffness.tolist(),
+        "reference": setup.reference,
+        "gap": setup.gap,
+        "closed_loop": setup.controller is not None,
+        "controller": _describe(setup.controller),
+        "speeds": [float(v) for v in sweep.speeds],
+        "amplitudes": [float(a) for a in sweep.amplitudes],
+        "duration": sweep.duration,
+        "dt": sweep.dt if setup.controller is None else float(setup.controller.dt),
+        "settle": sweep.settle,
+        "continuation": sweep.continuation,
+        "marches": marches,
+        "elapsed": time.perf_counter() - t0,
+        "workers": workers if scheduler is None else scheduler,
+        "notes": notes,
+    } | dict(sweep.extra)
+    return LCOResult(rows, settings, branches)
+
+
+def _describe(controller) -> str:
+    if controller is None:
+        return "open loop"
+    return str(getattr(controller, "name", None) or type(controller).__name__)
+
+
+def _describing(setup: LCOSetup, sweep: LCOSweep):
+    """The describing-function branches of the open loop, or None and a note why not."""
+    from ..stability.describing_function import describing_branches
+
+    if setup.controller is not None:
+        return None, (
+            "describing function: computed for the open loop only (the sampled controller "
+            "is not part of the equivalent linear system); compare with the open-loop study"
+        )
+    if any(getattr(law, "offset", 0.0) != 0.0 for law in setup.elements.laws):
+        return None, "describing function: not computed for a gap that is not centred at zero"
+    model = setup.loop.model if setup.loop is not None else setup.model
+    system = model.system(setup.density)
+    gap = setup.gap
+    top = max(sweep.amplitudes) * 4.0
+    if gap:
+        amps = 0.5 * gap * (1.0 + np.geomspace(1e-3, max(2.0 * top / gap, 2.0), 60))
+    else:
+        amps = np.geomspace(top * 1e-3, top, 60)
+    v = np.asarray(sweep.speeds, dtype=float)
+    speeds = np.linspace(0.5 * v.min(), 1.5 * v.max(), 240)
+    try:
+        return describing_branches(system, setup.elements, amps, speeds=speeds), None
+    except (InputError, ArithmeticError) as exc:
+        return None, f"describing function: not computed ({exc})"
