@@ -260,7 +260,7 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
     if scalar:
         q0, a0, i0 = iq.start, iad.start, iu.start
         mg, rt, hs = float(mag[0]), float(rate_dt[0]), 0.0
-    for k in range(n_steps):
+    for k in range(n_steps + 1):  # the last pass computes the command at the end only
         z, _, xz = views[k & 1]
         z1, z1h, x1 = views[(k + 1) & 1]
         if scalar:
@@ -289,6 +289,8 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
             z[iu] = h = u
         else:
             u = h
+        if k == n_steps:
+            break
         dot(ent[0], z, z1h)
         v1 = dot(cn2, x1).tolist()
         if leaves(v, v1, e, ent[3], ent[4], dt):
@@ -303,8 +305,6 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
             v1 = dot(cn2, xe).tolist()
         X[k + 1] = x1
         v = v1
-    if m:
-        U[n_steps], Cmd[n_steps] = U[n_steps - 1], Cmd[n_steps - 1]
     return X, U, Cmd, switches
 
 

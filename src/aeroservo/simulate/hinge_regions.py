@@ -8,15 +8,14 @@ known in closed form from the eigen-decomposition ``A_r = V diag(lambda) V^-1``:
     y(t) = exp(lambda t) y0 + (exp(lambda t) - 1) / lambda * gamma,   x = V y,
 
 and the time a rotation reaches an edge of its piece is the root of a scalar function, located
-by Brent's method to rounding (``docs/freeplay.md``). Region matrices are built once per region
-visited and cached.
+by Newton's method (kept in its bracket) to rounding (``docs/freeplay.md``). Region matrices
+are built once per region visited and cached.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.optimize import brentq
 
 from ..design.plant import zoh
 from ..errors import InputError
@@ -102,7 +101,8 @@ class Regions:
         return self._sampled[r]
 
     def eigen(self, r: tuple):
-        """``(lambda, V, V^-1, V^-1 [B g], C_n V, C_rate V)`` of region ``r``."""
+        """``(lambda, V, V^-1, V^-1 [B g], C_n V, C_rate V, [C_n V; C_rate V])`` of region
+        ``r``."""
         if r not in self._eigen:
             A, g, _, _ = self.system(r)
             lam, V = sla.eig(A)
@@ -114,7 +114,8 @@ class Regions:
                     f"decomposition residual {err:.1e}); it cannot be marched exactly"
                 )
             G = Vi @ np.hstack([self.B, g[:, None]])
-            self._eigen[r] = (lam, V, Vi, G, self.np.c_n @ V, self.np.c_rate @ V)
+            W, Wd = self.np.c_n @ V, self.np.c_rate @ V
+            self._eigen[r] = (lam, V, Vi, G, W, Wd, np.vstack([W, Wd]))
         return self._eigen[r]
 
     def interval(self, x: np.ndarray, r: tuple, u: np.ndarray, h: float, switches: list, t0: float):
@@ -129,14 +130,15 @@ class Regions:
         """
         t = 0.0
         for _ in range(10_000):
-            lam, V, Vi, G, W, Wd = self.eigen(r)[:6]
-            y0, gam = Vi @ x, G @ np.append(u, 1.0)
+            lam, V, Vi, G, W, Wd, WWd = self.eigen(r)
+            y0, gam = Vi @ x, G[:, :-1] @ u + G[:, -1]
             rest = h - t
             lo, hi = self.bounds(r)
             tol = 1e-12 * self.scale
-            bracket = self._quick(r, y0, gam, rest, lo - tol, hi + tol)
+            y1 = _path(lam, y0, gam, np.array([rest]))[:, 0]
+            bracket = _quick(WWd, y0, y1, rest, lo - tol, hi + tol)
             if bracket is None:  # no edge reached: the end of the interval
-                return _state(V, lam, y0, gam, rest), r
+                return (V @ y1).real, r
             if not bracket:  # scan the interval
                 taus = np.linspace(0.0, rest, _SUB + 1)
                 Y = _path(lam, y0, gam, taus)
@@ -148,16 +150,10 @@ class Regions:
                         fine = np.linspace(taus[j - 1], taus[j], 257)
                         bracket = _first_exit(_rot(W, lam, y0, gam, fine), fine, lo, hi, tol)
                 if bracket is None:
-                    return (V @ Y[:, -1]).real, r
+                    return (V @ y1).real, r
             ta, tb, e, upper = bracket
             edge = hi[e] if upper else lo[e]
-            gap = _scalar(W[e], lam, y0, gam, edge)
-            fa, fb = gap(ta), gap(tb)
-            tc = (
-                ta
-                if fa == 0.0 or np.sign(fa) == np.sign(fb)
-                else brentq(gap, ta, tb, xtol=1e-15, rtol=1e-15)
-            )
+            tc = _crossing(W[e], lam, y0, gam, edge, ta, tb, tol[e])
             x = _state(V, lam, y0, gam, tc)
             t += tc
             switches.append(t0 + t)
@@ -165,39 +161,6 @@ class Regions:
             if t >= h * (1.0 - 1e-14):
                 return x, r
         raise InputError("nonlinear march: more than 10000 switches in one sample (chattering)")
-
-    def _wwd(self, r):
-        """``[C_n V; C_rate V]`` of region ``r``."""
-        ent = self.eigen(r)
-        if len(ent) == 6:
-            self._eigen[r] = ent = ent + (np.vstack([ent[4], ent[5]]),)
-        return ent[6]
-
-    def _quick(self, r, y0, gam, rest, lo, hi):
-        """From the ends of the interval alone: None when no rotation reaches an edge (none
-        ends beyond one, none turns beyond one by its cubic Hermite interpolant); the bracket
-        ``(0, rest, element, upper)`` when exactly one rotation ends beyond an edge with at most
-        one turning point on the way (one crossing); False otherwise (scan the interval)."""
-        lam, V, Vi, G, W, Wd = self.eigen(r)[:6]
-        e = W.shape[0]
-        Y = _path(lam, y0, gam, np.array([0.0, rest]))
-        S = (self._wwd(r) @ Y).real
-        v0, v1 = S[:, 0].tolist(), S[:, 1].tolist()
-        lo_l, hi_l = lo.tolist(), hi.tolist()
-        if not leaves(v0, v1, e, lo_l, hi_l, rest):
-            return None
-        out = [j for j in range(e) if not lo_l[j] <= v1[j] <= hi_l[j]]
-        if len(out) != 1:
-            return False
-        j = out[0]
-        if _turns(v0[j], v1[j], v0[e + j] * rest, v1[e + j] * rest) > 1:
-            return False
-        for i in range(e):  # the others must not graze an edge
-            if i != j and leaves(
-                [v0[i], v0[e + i]], [v1[i], v1[e + i]], 1, [lo_l[i]], [hi_l[i]], rest
-            ):
-                return False
-        return 0.0, rest, j, v1[j] > hi_l[j]
 
 
 def _turns(s0: float, s1: float, r0: float, r1: float) -> int:
@@ -230,19 +193,99 @@ def _first_exit(s, taus, lo, hi, tol):
     return taus[j - 1], taus[j], e, not below[e, j]
 
 
-def _scalar(w, lam, y0, gam, edge):
-    """``tau -> w y(tau) - edge`` (real) for Brent's method: ``exp(lambda tau) (y0 +
-    gamma/lambda) - gamma/lambda`` when no eigenvalue is near zero, else the general form."""
-    if np.all(np.abs(lam) > 1e-6):
+def _quick(WWd, y0, y1, rest, lo, hi):
+    """From the ends of the interval alone (modal coordinates ``y0``, ``y1``): None when no
+    rotation reaches an edge (none ends beyond one, none turns beyond one by its cubic Hermite
+    interpolant); ``(0, rest, element, upper)`` when exactly one rotation ends beyond an edge
+    with at most one turning point on the way (one crossing); False otherwise (scan)."""
+    e = WWd.shape[0] // 2
+    v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
+    lo_l, hi_l = lo.tolist(), hi.tolist()
+    if not leaves(v0, v1, e, lo_l, hi_l, rest):
+        return None
+    out = [j for j in range(e) if not lo_l[j] <= v1[j] <= hi_l[j]]
+    if len(out) != 1:
+        return False
+    j = out[0]
+    if _turns(v0[j], v1[j], v0[e + j] * rest, v1[e + j] * rest) > 1:
+        return False
+    for i in range(e):  # the others must not graze an edge
+        if i != j and leaves([v0[i], v0[e + i]], [v1[i], v1[e + i]], 1, [lo_l[i]], [hi_l[i]], rest):
+            return False
+    return 0.0, rest, j, v1[j] > hi_l[j]
+
+
+def _crossing(w, lam, y0, gam, edge, ta, tb, atol) -> float:
+    """The time in ``[ta, tb]`` where ``w y(tau)`` reaches ``edge`` (a sign change there):
+    Newton's method on the closed form, kept in the bracket (bisection when a step leaves it),
+    to rounding. A start within ``atol`` of the edge (the rotation has just crossed it) looks
+    for the next crossing after its excursion into the region."""
+    if np.abs(lam).min() > 1e-6:
         off = gam / lam
-        wa, c0 = w * (y0 + off), float((w @ off).real) + edge
+        wa = w * (y0 + off)
+        wl = wa * lam
+        c0 = float((w @ off).real) + edge
+
+        def fs(taus):
+            return (wa @ np.exp(np.multiply.outer(lam, taus))).real - c0
 
         def f(tau):
-            return float((wa @ np.exp(lam * tau)).real) - c0
+            ex = np.exp(lam * tau)
+            return float((wa @ ex).real) - c0, float((wl @ ex).real)
+    else:
+        wd = w[None, :]
 
-        return f
-    w2 = w[None, :]
-    return lambda tau: _rot(w2, lam, y0, gam, np.array([tau]))[0, 0] - edge
+        def fs(taus):
+            return _rot(wd, lam, y0, gam, taus)[0] - edge
+
+        def f(tau):
+            v = _rot(wd, lam, y0, gam, np.array([tau, tau + 1e-9 * (tb - ta)]))[0]
+            return v[0] - edge, (v[1] - v[0]) / (1e-9 * (tb - ta))
+
+    fa, fb = f(ta)[0], f(tb)[0]
+    if fb == 0.0:
+        return tb
+    if abs(fa) <= atol:  # on the edge at the start (just switched): the crossing after it
+        for n in (32, 512):
+            grid = np.linspace(ta, tb, n + 1)[1:]
+            vals = fs(grid)
+            inside = np.flatnonzero(np.sign(vals) == -np.sign(fb))
+            if inside.size:
+                break
+        else:
+            return ta  # it only touches the edge: leave now
+        after = np.flatnonzero(np.sign(vals[inside[0] :]) == np.sign(fb))
+        k = inside[0] + int(after[0])
+        ta, fa, tb = grid[k - 1], vals[k - 1], grid[k]
+    if np.sign(fa) == np.sign(fb):
+        return ta
+    tau = ta + (tb - ta) * fa / (fa - fb)
+    span = tb - ta
+    for _ in range(60):
+        fv, dv = f(tau)
+        if fv == 0.0:
+            break
+        if np.sign(fv) == np.sign(fa):
+            ta, fa = tau, fv
+        else:
+            tb = tau
+        step = tau - fv / dv if dv != 0.0 else 0.5 * (ta + tb)
+        new = step if ta < step < tb else 0.5 * (ta + tb)
+        done = abs(new - tau) <= 1e-13 * span
+        tau = new
+        if done:
+            break
+    # on to the side beyond the edge (steps doubling from 1e-16 of the bracket): the new
+    # region starts on its own side
+    fv, dv = f(tau)
+    if np.sign(fv) == np.sign(fb):
+        return tau
+    step = max(2.0 * abs(fv / dv) if dv else 0.0, 8.0 * np.spacing(tau), 1e-18 * span)
+    for _ in range(12):
+        if tau >= tb or np.sign(f(tau)[0]) == np.sign(fb):
+            return min(tau, tb)
+        tau, step = max(tau + step, np.nextafter(tau, np.inf)), 2.0 * step
+    return tb
 
 
 def _phi1(lam: np.ndarray, taus: np.ndarray) -> np.ndarray:

@@ -46,7 +46,7 @@ def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, 
         return X, U, Cmd, []
     h, pending = np.zeros(m), np.zeros(m)
     xs = np.zeros(law.n_states) if law is not None else None
-    for k in range(n_steps):
+    for k in range(n_steps + 1):  # the last pass computes the command at the end only
         ys = x if (law is not None and law.state_feedback) else (
             Cs @ x + Ds @ h + Dns @ el.correction(c_n @ x)
         )  # fmt: skip
@@ -63,6 +63,8 @@ def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, 
         else:
             controller.update(ys, u)
         Cmd[k], U[k] = c, u
+        if k == n_steps:
+            break
         sol = solve_ivp(
             rhs, (0.0, dt), x, method="DOP853", rtol=RTOL, atol=atol, args=(Bu @ u,)
         )  # fmt: skip
@@ -70,7 +72,6 @@ def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, 
         x = sol.y[:, -1]
         X[k + 1] = x
         h = u
-    U[n_steps], Cmd[n_steps] = U[n_steps - 1], Cmd[n_steps - 1]
     return X, U, Cmd, []
 
 
