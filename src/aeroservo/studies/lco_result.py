@@ -186,20 +186,29 @@ def describing_lines(result) -> list[str]:
 
 
 def _branch_at(b, seen, speed: float, freq: float):
-    """``(amplitude, frequency)`` of a describing-function branch interpolated at ``speed``
-    between two neighbouring points (in amplitude) that are both seen, the one nearest in
-    frequency within 20 % of ``freq``; None if no branch passes there."""
+    """``(amplitude, frequency)`` of the describing function interpolated at ``speed`` between
+    two points of neighbouring amplitudes (or the same amplitude: across a fold) whose
+    frequencies are within 3 % (the same limit cycle), both stable and the one nearer in speed
+    seen (every other root damped); of the candidates, the one nearest in frequency within 20 %
+    of ``freq``; None if no branch passes there."""
+    amps = np.unique(b.amplitude)
     best = None
-    for br in np.unique(b.branch):
-        idx = np.flatnonzero(b.branch == br)
-        idx = idx[np.argsort(b.amplitude[idx])]
-        for i, j in zip(idx[:-1], idx[1:], strict=True):
-            v0, v1 = b.speed[i], b.speed[j]
-            if not (seen[i] and seen[j]) or not min(v0, v1) <= speed <= max(v0, v1) or v0 == v1:
-                continue
-            w = (speed - v0) / (v1 - v0)
-            f = (1 - w) * b.frequency[i] + w * b.frequency[j]
-            a = (1 - w) * b.amplitude[i] + w * b.amplitude[j]
-            if abs(f / freq - 1.0) < 0.2 and (best is None or abs(f - freq) < abs(best[1] - freq)):
-                best = (a, f)
+    for a0, a1 in zip(amps, np.r_[amps[1:], np.inf], strict=True):
+        here = np.flatnonzero(b.amplitude == a0)
+        for i in here:
+            for j in np.flatnonzero((b.amplitude == a1) | (b.amplitude == a0)):
+                v0, v1 = b.speed[i], b.speed[j]
+                if i == j or v0 == v1 or not min(v0, v1) <= speed <= max(v0, v1):
+                    continue
+                if abs(b.frequency[j] / b.frequency[i] - 1.0) > 0.03:
+                    continue
+                w = (speed - v0) / (v1 - v0)
+                if not (b.stable[i] and b.stable[j] and seen[i if w < 0.5 else j]):
+                    continue
+                f = (1 - w) * b.frequency[i] + w * b.frequency[j]
+                a = (1 - w) * b.amplitude[i] + w * b.amplitude[j]
+                if abs(f / freq - 1.0) < 0.2 and (
+                    best is None or abs(f - freq) < abs(best[1] - freq)
+                ):
+                    best = (a, f)
     return best

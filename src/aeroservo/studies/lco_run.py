@@ -121,13 +121,23 @@ def _describing(setup: LCOSetup, sweep: LCOSweep):
     model = setup.loop.model if setup.loop is not None else setup.model
     system = model.system(setup.density)
     gap = setup.gap
+    small = system.n_states <= 40  # a section: fine grids; a wing: coarser (eig per speed)
+    n = 120 if small else 36
     top = max(sweep.amplitudes) * 4.0
-    if gap:
-        amps = 0.5 * gap * (1.0 + np.geomspace(1e-3, max(2.0 * top / gap, 2.0), 60))
+    if gap:  # dense where limit cycles are (A/gap from 0.5 to 2), geometric beyond
+        ratio = np.concatenate(
+            [
+                0.5 + np.geomspace(1e-4, 0.05, n // 6, endpoint=False),
+                np.linspace(0.55, 2.0, 2 * n // 3, endpoint=False),
+                np.geomspace(2.0, max(top / gap, 4.0), n // 6),
+            ]
+        )
+        amps = gap * ratio
     else:
-        amps = np.geomspace(top * 1e-3, top, 60)
+        amps = np.geomspace(top * 1e-3, top, n)
     v = np.asarray(sweep.speeds, dtype=float)
-    speeds = np.linspace(0.5 * v.min(), 1.5 * v.max(), 240)
+    lo, hi = (0.5, 1.5) if small else (0.8, 1.2)
+    speeds = np.linspace(lo * v.min(), hi * v.max(), 240 if small else 80)
     try:
         return describing_branches(system, setup.elements, amps, speeds=speeds), None
     except (InputError, ArithmeticError) as exc:

@@ -50,8 +50,8 @@ class Run:
         The loop judged over its engaged speed range (controlled loops).
     trade : TradeResult or None
         Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
-    loads : GustLoadsResult or None
-        Gust loads (gust_loads scenarios).
+    loads, lco : GustLoadsResult, LCOResult or None
+        Gust loads (gust_loads scenarios), limit cycles (lco scenarios).
     folder : Path or None
         Folder of a trade study's outputs.
     title : str
@@ -69,6 +69,7 @@ class Run:
     judgement: object = None
     trade: object = None
     loads: object = None
+    lco: object = None
     folder: Path | None = None
     title: str = ""
 
@@ -319,7 +320,7 @@ def run_scenario(
     progress : bool
         Progress bars on stderr.
     scheduler, workers :
-        Dask scheduler address and local workers of a trade or gust-loads study.
+        Dask scheduler address and local workers of a trade, gust-loads or limit-cycle study.
 
     Returns
     -------
@@ -329,11 +330,14 @@ def run_scenario(
         return run_flutter(scenario, progress)
     if scenario.kind == "simulate":
         return run_simulation(scenario, progress)
-    if scenario.kind == "gust_loads":
+    if scenario.kind in ("gust_loads", "lco"):
         from .gust_scenario import run_gust_scenario
+        from .lco_scenario import run_lco_scenario
 
-        summary, res = run_gust_scenario(scenario, progress, scheduler, workers)
-        return Run(scenario, summary, loads=res, title=scenario.name)
+        study = {"gust_loads": ("loads", run_gust_scenario), "lco": ("lco", run_lco_scenario)}
+        field, run = study[scenario.kind]
+        summary, res = run(scenario, progress, scheduler, workers)
+        return Run(scenario, summary, **{field: res}, title=scenario.name)
     from .trade.cluster import run_trade
 
     if out_dir is None:

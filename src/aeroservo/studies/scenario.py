@@ -1,5 +1,6 @@
 """A scenario: what to run on which wing (open-loop flutter, closed-loop simulation, trade study,
-gust loads), with the flight condition, model options, signals, disturbance, controller and outputs.
+gust loads, limit cycles of nonlinear hinges), with the flight condition, model options, signals,
+disturbance, controller and outputs.
 Read from a scenario file by :mod:`aeroservo.files.scenario_file`; run by
 :mod:`aeroservo.studies.runs`.
 """
@@ -14,7 +15,7 @@ from ..system.damping import NO_DAMPING, StructuralDamping
 __all__ = ["Scenario", "Disturbance", "quick", "SCENARIO_KINDS"]
 
 
-SCENARIO_KINDS = ("flutter", "simulate", "trade", "gust_loads")
+SCENARIO_KINDS = ("flutter", "simulate", "trade", "gust_loads", "lco")
 GUST_TYPES = ("none", "one_minus_cosine", "turbulence", "series")
 GUST_KEYS = {
     "none": (),
@@ -47,7 +48,11 @@ class Scenario:
     ``trade`` holds a trade study's table and ``gust_loads`` a gust-loads study's (a dict:
     ``loads``, ``points`` (:class:`~aeroservo.studies.gust_loads.FlightPoint`), ``mass_cases``
     (name -> wing, the first the default), ``design_mass_case``, ``n_gradients``,
-    ``turbulence``, ``workers``, ``f_g`` or ``weights``); None for the other kinds.
+    ``turbulence``, ``workers``, ``f_g`` or ``weights``) and ``lco`` a limit-cycle study's
+    (``hinges``, ``speeds``, ``amplitudes``, ``duration``, ``dt``, ``settle``, ``continuation``,
+    ``history``, ``workers``, ``describing``, ``hinges_source``); None for the other kinds. A
+    limit-cycle study on a typical section has ``section`` (a
+    :class:`~aeroservo.system.section.TypicalSection`) and no ``wing``.
     """
 
     name: str
@@ -92,10 +97,16 @@ class Scenario:
     plots: bool = True
     trade: object = None
     gust_loads: object = None
+    lco: object = None
+    section: object = None
 
     def model(self):
-        """The aeroelastic model of the scenario's wing and options."""
+        """The aeroelastic model of the scenario's wing and options (its typical section, if
+        it has one)."""
         from ..system.aeroelastic import AeroelasticModel
+
+        if self.section is not None:
+            return self.section
 
         return AeroelasticModel(self.wing, self.elements, self.wagner, damping=self.damping)
 
@@ -152,7 +163,9 @@ class Scenario:
 def quick(s: Scenario) -> Scenario:
     """Fast settings of a scenario for smoke tests: at most 0.5 s simulated, an 11-point
     closed-loop grid, 3 margin speeds, two values per trade parameter and a 0.3 s gust in
-    trade studies; gust loads at the first two flight points with at most 5 gust gradients."""
+    trade studies; gust loads at the first two flight points with at most 5 gust gradients;
+    limit cycles at the first, middle and last speeds from the smallest and largest initial
+    rotations, at most 2 s each and no describing function."""
     from dataclasses import replace
 
     kw: dict = {
@@ -172,4 +185,13 @@ def quick(s: Scenario) -> Scenario:
         g["points"] = tuple(g["points"][:2])
         g["n_gradients"] = min(g["n_gradients"], 5)
         kw["gust_loads"] = g
+    if s.lco is not None:
+        c = dict(s.lco)
+        v, a = c["speeds"], sorted(c["amplitudes"])
+        c["speeds"] = tuple(sorted({v[0], v[len(v) // 2], v[-1]}))
+        c["amplitudes"] = tuple(sorted({a[0], a[-1]}))
+        c["duration"] = min(c["duration"], 2.0)
+        c["history"] = min(c["history"], c["duration"])
+        c["describing"] = False
+        kw["lco"] = c
     return replace(s, **kw)
