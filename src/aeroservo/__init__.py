@@ -11,6 +11,14 @@ from ._version import __version__
 from .errors import InputError
 
 _PUBLIC = {
+    "Freeplay": "structure.hinge_laws",
+    "Bilinear": "structure.hinge_laws",
+    "Cubic": "structure.hinge_laws",
+    "NonlinearHinge": "system.hinge_elements",
+    "TypicalSection": "system.section",
+    "march_hinges": "simulate.hinge_march",
+    "nonlinear_plant": "linear.hinge_plant",
+    "run_lco": "studies.lco_run",
     "AeroelasticModel": "system.aeroelastic",
     "ConcentratedMass": "structure.masses",
     "Actuator": "structure.wing",

@@ -13,6 +13,7 @@ controller at a design speed.
 from .boundary_result import ClosedLoopBoundary
 from .closed_loop import closed_loop_boundary, closed_loop_matrix
 from .compensator import DiscreteCompensator, compensator_from_lti
+from .hinge_loop import loop_hinge_plant
 from .interface import PythonLaw, StateGain, as_controller, python_law, static_gain
 from .judgement import EngagedRange, LoopJudgement, judge_loop
 from .law import LinearLaw
@@ -27,6 +28,7 @@ from .schedule import GainSchedule, schedule
 from .spec import ControllerSpec
 
 __all__ = [
+    "loop_hinge_plant",
     "Bryson",
     "ClosedLoopBoundary",
     "ControlLoop",

@@ -6,6 +6,9 @@ state-space builder (:mod:`.state_space`), models at a flight condition or over 
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "NonlinearPlant": "hinge_plant",
+    "nonlinear_plant": "hinge_plant",
+    "section_plant": "hinge_plant",
     "Sensor": "signals",
     "Servo": "state_space",
     "StateSpaceBuilder": "state_space",
@@ -18,6 +21,9 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "NonlinearPlant",
+    "nonlinear_plant",
+    "section_plant",
     "Sensor",
     "Servo",
     "StateSpaceBuilder",

@@ -13,6 +13,7 @@ results, their files and the API keep radians.
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "plot_describing": "lco",
     "plot_envelope": "flutter",
     "plot_loop_margins": "margins",
     "plot_margin_sweep": "margins",
@@ -26,6 +27,7 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "plot_describing",
     "plot_vg",
     "plot_root_locus",
     "plot_mode_shapes",

@@ -5,11 +5,19 @@ limits (:mod:`.march`), and the time histories it produces (:mod:`.result`).
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "march_hinges": "hinge_march",
+    "HingeSimulation": "hinge_march",
+    "classify": "lco_detect",
+    "LCOVerdict": "lco_detect",
     "SimulationResult": "result",
     "simulate": "march",
 }
 
 __all__ = [
+    "march_hinges",
+    "HingeSimulation",
+    "classify",
+    "LCOVerdict",
     "SimulationResult",
     "simulate",
 ]

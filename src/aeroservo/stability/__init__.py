@@ -8,6 +8,8 @@ divergence boundary (:mod:`.boundary`, :mod:`.divergence`), dense eigenvalue swe
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "DescribingBranches": "describing_function",
+    "describing_branches": "describing_function",
     "Crossing": "result",
     "EigenSweep": "sweep",
     "FlutterResult": "result",
@@ -20,6 +22,8 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "DescribingBranches",
+    "describing_branches",
     "Crossing",
     "EigenSweep",
     "FlutterResult",

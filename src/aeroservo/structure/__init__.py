@@ -6,6 +6,9 @@ element's shape functions (:mod:`.beam_element`) and the built-in wings (:mod:`.
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "Freeplay": "hinge_laws",
+    "Bilinear": "hinge_laws",
+    "Cubic": "hinge_laws",
     "Actuator": "wing",
     "ControlSurface": "wing",
     "Mesh": "mesh",
@@ -17,6 +20,9 @@ _PUBLIC = {
 _MODULES = {"examples": "examples"}
 
 __all__ = [
+    "Freeplay",
+    "Bilinear",
+    "Cubic",
     "Actuator",
     "ControlSurface",
     "Mesh",

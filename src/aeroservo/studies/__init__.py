@@ -6,6 +6,10 @@ flight points (:mod:`.gust_loads`, :mod:`.gust_run`).
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "LCOSetup": "lco",
+    "LCOSweep": "lco",
+    "LCOResult": "lco_result",
+    "run_lco": "lco_run",
     "Run": "runs",
     "Scenario": "scenario",
     "quick": "scenario",
@@ -18,6 +22,10 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "LCOSetup",
+    "LCOSweep",
+    "LCOResult",
+    "run_lco",
     "Run",
     "Scenario",
     "quick",

@@ -7,6 +7,9 @@ together: a wing stick model (:mod:`.aeroelastic`) and a typical section (:mod:`
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
+    "NonlinearHinge": "hinge_elements",
+    "HingeElements": "hinge_elements",
+    "conner_section": "section",
     "AeroMatrices": "matrices",
     "AeroelasticModel": "aeroelastic",
     "FirstOrderSystem": "first_order",
@@ -16,6 +19,9 @@ _PUBLIC = {
 }
 
 __all__ = [
+    "NonlinearHinge",
+    "HingeElements",
+    "conner_section",
     "AeroMatrices",
     "AeroelasticModel",
     "FirstOrderSystem",
