@@ -60,6 +60,7 @@ class Regions:
         self.scale = np.array([max(np.ptp(t[0]) if t[0].size else 0.0, 1e-6) for t in self.tables])
         self._sampled: dict = {}
         self._eigen: dict = {}
+        self._edges: dict = {}
 
     def locate(self, s: np.ndarray) -> tuple:
         """The region (piece index per element) of the rotations ``s`` [rad]."""
@@ -119,6 +120,17 @@ class Regions:
             G = Vi @ np.hstack([self.B, g[:, None]])
             W, Wd = self.np.c_n @ V, self.np.c_rate @ V
             self._eigen[r] = (lam, V, Vi, G, W, Wd, np.vstack([W, Wd]))
+            lo, hi = self.bounds(r)
+            tol = 1e-12 * self.scale
+            self._edges[r] = (
+                lo,
+                hi,
+                tol,
+                (lo - tol).tolist(),
+                (hi + tol).tolist(),
+                G[:, :-1],
+                G[:, -1],
+            )
         return self._eigen[r]
 
     def interval(self, x: np.ndarray, r: tuple, u: np.ndarray, h: float, switches: list, t0: float):
@@ -134,15 +146,19 @@ class Regions:
         t = 0.0
         for _ in range(10_000):
             lam, V, Vi, G, W, Wd, WWd = self.eigen(r)
-            y0, gam = Vi @ x, G[:, :-1] @ u + G[:, -1]
+            lo, hi, tol, lo_l, hi_l, Gu, gg = self._edges[r]
+            y0 = Vi @ x
+            gam = Gu @ u + gg if Gu.shape[1] else gg
             rest = h - t
-            lo, hi = self.bounds(r)
-            tol = 1e-12 * self.scale
             y1 = _path(lam, y0, gam, np.array([rest]))[:, 0]
-            bracket = _quick(WWd, y0, y1, rest, lo - tol, hi + tol)
+            v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
+            bracket = _quick(v0, v1, rest, lo_l, hi_l)
+            ends = None
             if bracket is None:  # no edge reached: the end of the interval
                 return (V @ y1).real, r
-            if not bracket:  # scan the interval
+            if bracket:
+                ends = (v0[bracket[2]], v1[bracket[2]])
+            else:  # scan the interval
                 taus = np.linspace(0.0, rest, _SUB + 1)
                 Y = _path(lam, y0, gam, taus)
                 s = (W @ Y).real
@@ -156,7 +172,7 @@ class Regions:
                     return (V @ y1).real, r
             ta, tb, e, upper = bracket
             edge = hi[e] if upper else lo[e]
-            tc = _crossing(W[e], lam, y0, gam, edge, ta, tb, tol[e])
+            tc = _crossing(W[e], lam, y0, gam, edge, ta, tb, tol[e], ends)
             x = _state(V, lam, y0, gam, tc)
             t += tc
             switches.append(t0 + t)
@@ -196,33 +212,33 @@ def _first_exit(s, taus, lo, hi, tol):
     return taus[j - 1], taus[j], e, not below[e, j]
 
 
-def _quick(WWd, y0, y1, rest, lo, hi):
-    """From the ends of the interval alone (modal coordinates ``y0``, ``y1``): None when no
-    rotation reaches an edge (none ends beyond one, none turns beyond one by its cubic Hermite
-    interpolant); ``(0, rest, element, upper)`` when exactly one rotation ends beyond an edge
-    with at most one turning point on the way (one crossing); False otherwise (scan)."""
-    e = WWd.shape[0] // 2
-    v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
-    lo_l, hi_l = lo.tolist(), hi.tolist()
-    if not leaves(v0, v1, e, lo_l, hi_l, rest):
+def _quick(v0: list, v1: list, rest: float, lo: list, hi: list):
+    """From the rotations and rates at the ends of the interval alone (``v0``, ``v1``: the
+    rotations then their rates): None when no rotation reaches an edge (none ends beyond one,
+    none turns beyond one by its cubic Hermite interpolant); ``(0, rest, element, upper)`` when
+    exactly one rotation ends beyond an edge with at most one turning point on the way (one
+    crossing); False otherwise (scan)."""
+    e = len(v0) // 2
+    if not leaves(v0, v1, e, lo, hi, rest):
         return None
-    out = [j for j in range(e) if not lo_l[j] <= v1[j] <= hi_l[j]]
+    out = [j for j in range(e) if not lo[j] <= v1[j] <= hi[j]]
     if len(out) != 1:
         return False
     j = out[0]
     if _turns(v0[j], v1[j], v0[e + j] * rest, v1[e + j] * rest) > 1:
         return False
     for i in range(e):  # the others must not graze an edge
-        if i != j and leaves([v0[i], v0[e + i]], [v1[i], v1[e + i]], 1, [lo_l[i]], [hi_l[i]], rest):
+        if i != j and leaves([v0[i], v0[e + i]], [v1[i], v1[e + i]], 1, [lo[i]], [hi[i]], rest):
             return False
-    return 0.0, rest, j, v1[j] > hi_l[j]
+    return 0.0, rest, j, v1[j] > hi[j]
 
 
-def _crossing(w, lam, y0, gam, edge, ta, tb, atol) -> float:
+def _crossing(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
     """The time in ``[ta, tb]`` where ``w y(tau)`` reaches ``edge`` (a sign change there):
     Newton's method on the closed form, kept in the bracket (bisection when a step leaves it),
     to rounding. A start within ``atol`` of the edge (the rotation has just crossed it) looks
-    for the next crossing after its excursion into the region."""
+    for the next crossing after its excursion into the region. ``ends``: the rotations at
+    ``ta`` and ``tb`` when known."""
     if np.abs(lam).min() > 1e-6:
         off = gam / lam
         wa = w * (y0 + off)
@@ -245,7 +261,7 @@ def _crossing(w, lam, y0, gam, edge, ta, tb, atol) -> float:
             v = _rot(wd, lam, y0, gam, np.array([tau, tau + 1e-9 * (tb - ta)]))[0]
             return v[0] - edge, (v[1] - v[0]) / (1e-9 * (tb - ta))
 
-    fa, fb = f(ta)[0], f(tb)[0]
+    fa, fb = (ends[0] - edge, ends[1] - edge) if ends else (f(ta)[0], f(tb)[0])
     if fb == 0.0:
         return tb
     if abs(fa) <= atol:  # on the edge at the start (just switched): the crossing after it
