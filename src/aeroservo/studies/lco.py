@@ -27,6 +27,10 @@ from ..system.hinge_elements import NonlinearHinge, hinge_elements
 
 __all__ = ["LCOSetup", "LCOSweep", "march_task", "HISTORY_SAMPLES"]
 
+DIVERGED = 10.0
+"""A growing march is called divergent once its reference rotation exceeds this many gaps
+(below: "growing", not settled within the march)."""
+
 HISTORY_SAMPLES = 4000
 """Samples kept of each march's last ``history`` seconds (for the example time histories)."""
 
@@ -187,6 +191,8 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
         signals[f"{n}_hinge_moment"] = res.hinge_moments[n]
     for o, y in res.outputs.items():
         signals.setdefault(o, y)
+    for c, y in res.applied.items():  # the moments the controller applied
+        signals[f"{c}_applied"] = y
     ref = f"{setup.reference}_rotation"
     verdict = classify(res.t, signals, reference=ref, settle=sweep.settle)
     keep = res.t >= res.t[-1] - sweep.history
@@ -196,9 +202,13 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
     gap = setup.gap
     kind_, reason = verdict.kind, verdict.reason
     reach = float(np.max(np.abs(res.rotations[setup.reference] - _centre(setup))))
-    if kind_ == "divergence" and gap and reach < 0.5 * gap and np.isfinite(reach):
-        kind_ = "growing"  # unstable inside the gap, the march ended before the edges
-        reason = f"grows inside the gap (largest rotation {reach / gap:.3g} x gap); " + reason
+    if kind_ == "divergence" and gap and np.isfinite(reach) and reach < DIVERGED * gap:
+        kind_ = "growing"  # not settled at the end of the march, and still moderate
+        where = "inside the gap" if reach < 0.5 * gap else "still moderate"
+        reason = (
+            f"grows, {where} (largest rotation {reach / gap:.3g} x gap): march longer to see "
+            "where it settles; " + reason
+        )
     row = {
         "start": kind,
         "speed": float(speed),

@@ -30,7 +30,8 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
     Points marched from rest with each initial rotation are dots (colour: initial rotation);
     the up and down sweeps (continuation) are lines with ``>`` and ``<`` markers; marches that
     decayed are open circles at zero, that diverged crosses at the top, that were aperiodic
-    or undecided triangles and squares at their amplitude. The describing-function branches are
+    or undecided triangles and squares, and that were still growing (not settled) open
+    down-triangles, at their amplitude. The describing-function branches are
     drawn over it (solid stable, dashed unstable).
     """
     if ax is None:
@@ -52,7 +53,7 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
         )  # fmt: skip
         for kind, (m, face) in _MARK.items():
             sel = [r for r in pts if r["kind"] == kind]
-            y = [0.0 if kind in ("decay", "growing") else r["amplitude"] * k for r in sel]
+            y = [0.0 if kind == "decay" else r["amplitude"] * k for r in sel]
             ax.plot([r["speed"] for r in sel], y, m, color=col, mfc=face or col, ms=5, zorder=3)
         div = [r for r in pts if r["kind"] in ("divergence", "failed")]
         ax.plot([r["speed"] for r in div], [top] * len(div), "x", color=col, ms=7, zorder=3)
@@ -62,7 +63,7 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
             continue
         y = [
             top if r["kind"] in ("divergence", "failed")
-            else 0.0 if r["kind"] in ("decay", "growing") else r["amplitude"] * k
+            else 0.0 if r["kind"] == "decay" else r["amplitude"] * k
             for r in sw
         ]  # fmt: skip
         ax.plot(
@@ -75,7 +76,7 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
         plot_describing(result.branches, ax=ax, per_gap=per_gap)
         ax.set_yscale("linear")
     ax.plot([], [], "o", color="grey", mfc="none", label="decays (drawn at 0)")
-    ax.plot([], [], "v", color="grey", mfc="none", label="grows inside the gap (at 0)")
+    ax.plot([], [], "v", color="grey", mfc="none", label="still growing (not settled)")
     ax.plot([], [], "^", color="grey", label="aperiodic")
     ax.plot([], [], "x", color="grey", label="diverges (drawn at the top)")
     ax.set_ylim(-0.03 * top, 1.05 * top)

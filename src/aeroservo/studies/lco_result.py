@@ -84,14 +84,14 @@ class LCOResult:
         return float(min(v)) if v else float("nan")
 
     def hysteresis(self) -> list[float]:
-        """Speeds [m/s] where the up and down sweeps end in different states (one in a limit
-        cycle, the other not, or amplitudes differing by more than 5 %)."""
+        """Speeds [m/s] where the up and down sweeps end in different states (different
+        verdicts, or limit cycles whose amplitudes differ by more than 5 %)."""
         up = {r["speed"]: r for r in self.rows if r["start"] == "up"}
         down = {r["speed"]: r for r in self.rows if r["start"] == "down"}
         out = []
         for v in sorted(set(up) & set(down)):
             a, b = up[v], down[v]
-            if (a["kind"] == "lco") != (b["kind"] == "lco"):
+            if a["kind"] != b["kind"]:
                 out.append(v)
             elif a["kind"] == "lco" and abs(a["amplitude"] - b["amplitude"]) > 0.05 * max(
                 a["amplitude"], b["amplitude"]
@@ -124,6 +124,13 @@ class LCOResult:
         dv = self.diverged_from()
         if np.isfinite(dv):
             lines.append(f"divergent motion from {dv:.4g} m/s")
+        grow = sorted({r["speed"] for r in self.rows if r["kind"] == "growing"})
+        if grow:
+            lines.append(
+                "still growing at the end of the march (not settled; march longer) at "
+                + ", ".join(f"{v:.4g}" for v in grow)
+                + " m/s"
+            )
         hyst = self.hysteresis()
         if hyst:
             lines.append(
