@@ -142,6 +142,7 @@ FLUTTER_MODULES = {
             ".analysis",
             ".envelope",
             ".importing",
+            ".lco",
             ".loads",
             ".options",
             ".optimize",

@@ -29,6 +29,7 @@ EXPECTED = {
     "06_sensitivities_and_tailoring.ipynb",
     "07_bring_your_own_controller.ipynb",
     "08_gust_loads.ipynb",
+    "09_freeplay_lco.ipynb",
 }
 KERNEL = "python3"
 

@@ -18,7 +18,7 @@ SCENARIOS = [p for p, _kind, _name in shipped_scenarios()]
 
 def test_scenarios_are_shipped():
     kinds = {k for _p, k, _n in shipped_scenarios()}
-    assert kinds == {"flutter", "simulate", "trade", "gust_loads"}
+    assert kinds == {"flutter", "simulate", "trade", "gust_loads", "lco"}
     names = {p.stem for p in SCENARIOS}
     for required in (
         "goland_flutter",
@@ -39,7 +39,7 @@ def test_every_shipped_scenario_runs(path, tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0, out
     summary = json.loads(out)
-    assert summary["kind"] in ("flutter", "simulate", "trade", "gust_loads")
+    assert summary["kind"] in ("flutter", "simulate", "trade", "gust_loads", "lco")
     written = sorted(p.name for p in tmp_path.rglob("*") if p.is_file())
     assert written and not [n for n in written if n.startswith(".")]  # no temporary files
     if summary["kind"] == "simulate":

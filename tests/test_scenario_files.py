@@ -100,7 +100,7 @@ def test_shipped_files_found():
 @pytest.mark.parametrize("name", SHIPPED_SCENARIOS)
 def test_shipped_scenario_loads(name):
     s = load_scenario(SCENARIOS / name)
-    assert s.name and s.kind in ("flutter", "simulate", "trade", "gust_loads")
+    assert s.name and s.kind in ("flutter", "simulate", "trade", "gust_loads", "lco")
     if s.kind == "simulate":
         assert s.controller is not None
     if s.kind == "trade":

@@ -4,8 +4,9 @@ Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical fa
 3 a closed-loop simulation whose loop is unstable (unless the scenario expects it).
 Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
 need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``),
-:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``examples``), :mod:`.loads` (``loads``)
-and :mod:`.results` (``plot``, ``export``), :mod:`.importing` (``import nastran``).
+:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``examples``), :mod:`.loads` (``loads``),
+:mod:`.lco` (``lco``) and :mod:`.results` (``plot``, ``export``), :mod:`.importing`
+(``import nastran``).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from collections.abc import Sequence
 
 from .._threads import blas_limited, blas_threads
 from ..errors import InputError
-from . import analysis, importing, loads, optimize, results, scenarios, sensitivity
+from . import analysis, importing, lco, loads, optimize, results, scenarios, sensitivity
 
 __all__ = ["main"]
 
@@ -49,6 +50,7 @@ def _parser() -> argparse.ArgumentParser:
     analysis.add_parsers(sub)
     scenarios.add_parsers(sub)
     loads.add_parsers(sub)
+    lco.add_parsers(sub)
     results.add_parsers(sub)
     sensitivity.add_parsers(sub)
     optimize.add_parsers(sub)
@@ -149,6 +151,7 @@ def _run(args: argparse.Namespace) -> int:
         **analysis.HANDLERS,
         **scenarios.HANDLERS,
         **loads.HANDLERS,
+        **lco.HANDLERS,
         **results.HANDLERS,
         **sensitivity.HANDLERS,
         **optimize.HANDLERS,

@@ -218,6 +218,11 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
         from ..files.scenario_file import load_scenario
 
         sc = load_scenario(args.wing)  # a scenario: its wing, flight condition and options
+        if sc.wing is None:
+            raise InputError(
+                f"{args.wing}: section: a typical section, not a wing; run the scenario with "
+                "'aeroservo lco'"
+            )
         wing = sc.wing
         opts = AnalysisOptions(
             sc.density,

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import argparse
 
+from .lco import LCO_KINDS
 from .options import add_flight_options, add_model_options, positive_float, quantity
 
 __all__ = ["add_parsers", "HANDLERS"]
 
 FLUTTER_KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
 GUST_KINDS = ("envelope", "correlated", "critical-gusts")
-KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope", *GUST_KINDS[1:])
+KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope", *GUST_KINDS[1:], *LCO_KINDS)
 
 
 def _mode_list(text: str) -> list[int]:
@@ -41,11 +42,12 @@ def add_parsers(sub) -> None:
         "vf, root-locus, modes, flutter-mode), a simulation written by 'aeroservo simulate' "
         "(time), a trade study's folder (pareto, heatmap: --metric and --slice choose the "
         "metric and the other parameters' values) or an envelope saved by 'aeroservo envelope "
-        "--save' (envelope) or gust loads written by 'aeroservo loads' (RESULT.json: envelope, "
-        "correlated, critical-gusts; all of them without --kind and --out).",
+        "--save' (envelope), gust loads written by 'aeroservo loads' (RESULT.json: envelope, "
+        "correlated, critical-gusts) or limit cycles written by 'aeroservo lco' (RESULT.json: "
+        "bifurcation, histories); all of a result's figures without --kind and --out.",
     )
     pl.add_argument(
-        "result", help="result file (.npz, envelope or gust-loads .json) or trade folder"
+        "result", help="result file (.npz, envelope, gust-loads or lco .json) or trade folder"
     )
     pl.add_argument("--out", metavar="FILE", help="figure file (default: RESULT with .png)")
     pl.add_argument("--kind", choices=KINDS, help="figure (default: vg, time, pareto, envelope)")
@@ -130,6 +132,10 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         raise InputError(f"--fmax, --modes and --eas apply to flutter sweeps, not to {what}")
     if kinds == GUST_KINDS:
         return _gust_figures(res, src, args, kind)
+    if kinds == LCO_KINDS:
+        from .lco import plot_saved
+
+        return plot_saved(res, src, args, kind)
     if kind in FLUTTER_KINDS:
         fig = _flutter_figure(res, kind, args)
     elif kind == "time":
@@ -263,6 +269,8 @@ def _what(res) -> tuple[str, tuple]:
     """What a loaded result is, and the figure kinds it has (default first)."""
     if hasattr(res, "alleviation"):
         return "gust loads", GUST_KINDS
+    if hasattr(res, "hysteresis"):
+        return "limit cycles", LCO_KINDS
     if hasattr(res, "pk"):
         return "a flutter sweep", FLUTTER_KINDS
     if hasattr(res, "pareto"):

@@ -14,7 +14,7 @@ __all__ = ["add_parsers", "HANDLERS"]
 def add_parsers(sub) -> None:
     """The scenario commands' parsers."""
     for name, helptext in (
-        ("run", "run a scenario of any kind (flutter, simulate, trade, gust_loads)"),
+        ("run", "run a scenario of any kind (flutter, simulate, trade, gust_loads, lco)"),
         ("simulate", "run a closed-loop time simulation scenario"),
         ("trade", "run a trade-study scenario on Dask"),
     ):
@@ -65,7 +65,8 @@ def _cmd_examples(args: argparse.Namespace) -> int:
                 data = read_toml(path)
             except InputError:
                 continue
-            if set(data) <= {"wing", "analysis", "damping"} and isinstance(data.get("wing"), dict):
+            top = {"wing", "analysis", "damping", "hinges"}
+            if set(data) <= top and isinstance(data.get("wing"), dict):
                 wings.append((path.name, str(data["wing"].get("name", ""))))
         if wings:
             print("wing files (aeroservo flutter FILE, aes.load_model(FILE)):")
@@ -90,6 +91,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from .loads import run_loaded
 
         return run_loaded(scenario, args)
+    if scenario.kind == "lco":  # 'aeroservo run': as 'aeroservo lco' does
+        from .lco import run_lco_loaded
+
+        return run_lco_loaded(scenario, args)
     if args.quick:
         scenario = quick(scenario)
     if getattr(args, "scheduler", None) and scenario.kind != "trade":

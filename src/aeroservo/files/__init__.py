@@ -12,6 +12,8 @@ _PUBLIC = {
     "WingModel": "wing_model",
     "load_controller": "controller_file",
     "load_gust_loads": "gust_loads_file",
+    "load_hinges": "wing_file",
+    "load_lco": "lco_file",
     "load_model": "wing_model",
     "load_result": "results",
     "load_scenario": "scenario_file",
@@ -19,6 +21,7 @@ _PUBLIC = {
     "resolve_wing": "wing_file",
     "save_result": "results",
     "write_gust_loads": "gust_loads_file",
+    "write_lco": "lco_file",
     "write_run": "outputs",
 }
 
@@ -28,6 +31,8 @@ __all__ = [
     "export_npz",
     "load_controller",
     "load_gust_loads",
+    "load_hinges",
+    "load_lco",
     "load_model",
     "load_result",
     "load_scenario",
@@ -35,6 +40,7 @@ __all__ = [
     "resolve_wing",
     "save_result",
     "write_gust_loads",
+    "write_lco",
     "write_run",
 ]
 

@@ -11,7 +11,10 @@ range) for a controlled linear loop, and ``<result>.json``; a trade study writes
 ``<result>.json`` (summary and every record), ``<result>.npz`` (critical-gust histories),
 ``<result>.csv`` (limit loads), ``<result>_alleviation.csv`` (both loops) and the figures
 ``<result>_envelope.png``, ``<result>_correlated.png`` and ``<result>_critical_gusts.png``
-(:mod:`aeroservo.files.gust_loads_file`). Every file of a
+(:mod:`aeroservo.files.gust_loads_file`); limit cycles write ``<result>.json``, ``<result>.csv``,
+``<result>_branches.csv``, ``<result>_histories.npz``, ``<result>_summary.txt``,
+``<result>_bifurcation.png`` and ``<result>_histories.png`` (:mod:`aeroservo.files.lco_file`).
+Every file of a
 run is renamed into place only when all of them have been written
 (:func:`aeroservo.atomic.atomic_write_set`), so a failed run leaves none behind.
 """
@@ -103,14 +106,22 @@ def _write_run(run: Run, out: Path) -> dict[str, str]:
 
         json_path = out / f"{sc.result}.json"
         files["summary"] = str(json_path)
-    elif sc.kind == "gust_loads":
+    elif sc.kind in ("gust_loads", "lco"):
         from ..studies.gust_scenario import gust_figures
+        from ..studies.lco_scenario import lco_figures
         from .gust_loads_file import gust_loads_items
+        from .lco_file import lco_items
 
-        data = gust_loads_items(run.loads, out / f"{sc.result}.json", summary)
+        gust = sc.kind == "gust_loads"
+        res, items_of, figures = (
+            (run.loads, gust_loads_items, gust_figures)
+            if gust
+            else (run.lco, lco_items, lco_figures)
+        )
+        data = items_of(res, out / f"{sc.result}.json", summary)
         for kind, (path, writer) in data.items():
             add(kind, path, writer)  # the JSON's text is made when written, files included
-        for name, fig in gust_figures(run.loads).items() if plots else ():
+        for name, fig in figures(res).items() if plots else ():
             png = out / f"{sc.result}_{name}.png"
             add(f"{name}_plot", png, figure_writer(fig, png, dpi=120))
         summary["files"] = files

@@ -99,8 +99,9 @@ def _load_envelope(path: Path):
 def load_result(path: str | Path):
     """Read a result written by :func:`save_result`: a ``SimulationResult``, a
     :class:`~aeroservo.files.flutter_file.SavedFlutter` for a flutter sweep, a trade study's
-    folder (``TradeResult``), a flutter envelope saved as JSON (``Envelope``) or a gust-loads
-    result's JSON (``GustLoadsResult``)."""
+    folder (``TradeResult``), a flutter envelope saved as JSON (``Envelope``), a gust-loads
+    result's JSON (``GustLoadsResult``) or a limit-cycle result's JSON (``LCOResult``, with its
+    time histories when its NPZ is next to it)."""
     from .flutter_file import FORMAT, open_npz, read_flutter
     from .user_files import user_path
 
@@ -111,9 +112,12 @@ def load_result(path: str | Path):
         return load_trade(path)
     if path.suffix.lower() == ".json":
         from .gust_loads_file import is_gust_loads_file, load_gust_loads
+        from .lco_file import is_lco_file, load_lco
 
         if is_gust_loads_file(path):
             return load_gust_loads(path)
+        if is_lco_file(path):
+            return load_lco(path)
         return _load_envelope(path)
     data, meta = open_npz(path)
     fmt = meta.get("format")

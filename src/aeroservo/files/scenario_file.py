@@ -1,8 +1,10 @@
 """Scenario files (``scenarios/*.toml``, schema in ``docs/scenarios.md``).
 
 A scenario says what to run on which wing: an open-loop flutter analysis (``kind =
-"flutter"``), a closed-loop time simulation (``"simulate"``), a trade study (``"trade"``) or
-gust loads (``"gust_loads"``, its tables in :mod:`aeroservo.files.gust_loads_tables`),
+"flutter"``), a closed-loop time simulation (``"simulate"``), a trade study (``"trade"``),
+gust loads (``"gust_loads"``, its tables in :mod:`aeroservo.files.gust_loads_tables`) or limit
+cycles of nonlinear hinges (``"lco"``, on a wing or a typical section, its tables in
+:mod:`aeroservo.files.lco_tables`),
 with the flight condition, model options, signals, disturbance, a reference to a controller
 file, simulation settings and what to write. :func:`load_scenario` validates everything,
 including the cross-checks that need the wing (signals, sensor stations, controller signals,
@@ -18,6 +20,7 @@ from ..simulate.march import MAX_SAMPLES
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
 from .gust_loads_tables import gust_cross_check, gust_loads_tables
+from .lco_tables import lco_cross_check, lco_tables, section_table
 from .scenario_checks import cross_check
 from .scenario_tables import (
     controller,
@@ -46,10 +49,12 @@ TOP = (
     "damping",
     "trade",
     "gust_loads",
+    "lco",
+    "section",
 )
 USED = {
     "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping"),
-    "simulate": TOP[:-2],
+    "simulate": TOP[:-4],
     "trade": (
         "scenario",
         "wing",
@@ -72,6 +77,19 @@ USED = {
         "output",
         "damping",
         "gust_loads",
+    ),
+    "lco": (
+        "scenario",
+        "wing",
+        "section",
+        "flight",
+        "model",
+        "signals",
+        "controller",
+        "simulation",
+        "output",
+        "damping",
+        "lco",
     ),
 }
 
@@ -139,19 +157,26 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
 
     base = Path(file).parent if base is None else base
     check_integers(data, file)
-    top = Table(data, "", file).check_keys(("scenario", "wing"), TOP[2:])
+    top = Table(data, "", file).check_keys(("scenario",), TOP[1:])
     sc = top.table("scenario").check_keys(("name", "kind"), ("description",))
     kind = sc.string("kind", choices=SCENARIO_KINDS, required=True)
     for key in TOP:
         if top.has(key) and key not in USED[kind]:
             top.fail(key, top.data[key], f"not used by a scenario of kind {kind!r}")
+    section = kind == "lco" and top.has("section")  # a typical section instead of a wing
+    if not section and not top.has("wing"):
+        also = " (or [section], a typical section)" if kind == "lco" else ""
+        raise InputError(f"{file}: wing: missing required key{also}")
     kw: dict = {
         "name": sc.string("name", required=True),
         "kind": kind,
         "source": file,
         "description": sc.string("description", ""),
     }
-    kw["wing"], kw["wing_source"], wing_damping = _wing(top.table("wing"), base)
+    if section:
+        kw["wing"], kw["wing_source"], wing_damping = None, "section", None
+    else:
+        kw["wing"], kw["wing_source"], wing_damping = _wing(top.table("wing"), base)
     wing = kw["wing"]
 
     fl = top.table("flight").check_keys(
@@ -189,7 +214,8 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         kw["damping"] = wing_damping
     kw["elements"] = md.integer("elements", 10, lo=1, hi=MAX_ELEMENTS)
     try:
-        build_mesh(wing, kw["elements"])
+        if wing is not None:
+            build_mesh(wing, kw["elements"])
     except InputError as exc:  # too few elements for the wing's breakpoints
         md.fail("elements", kw["elements"], str(exc).split(": ", 1)[-1])
     if md.has("wagner"):
@@ -207,7 +233,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     sg = top.table("signals").check_keys(
         (), ("controls", "sensors", "outputs", "sensor_filter", "filter_order")
     )
-    surfaces = [cs.name for cs in wing.control_surfaces]
+    surfaces = [cs.name for cs in wing.control_surfaces] if wing is not None else []
     default_controls = [f"{surfaces[0]}_hinge_moment"] if surfaces else []
     kw["controls"] = tuple(sg.strings("controls", default_controls))
     kw["sensors"] = tuple(sg.strings("sensors", ["tip_le_accel", "tip_te_accel", "tip_twist"]))
@@ -282,9 +308,14 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         kw["trade"] = trade_table(top.table("trade", required=True), base)
     if kind == "gust_loads":
         gust_loads_tables(top, base, kw)
+    if section:
+        section_table(top, kw)
+    if kind == "lco":
+        lco_tables(top, base, kw)
 
     scenario = Scenario(**kw)
-    (gust_cross_check if kind == "gust_loads" else cross_check)(scenario, top)
+    checks = {"gust_loads": gust_cross_check, "lco": lco_cross_check}
+    checks.get(kind, cross_check)(scenario, top)
     return scenario
 
 

@@ -10,6 +10,7 @@ the key and the value.
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -17,7 +18,14 @@ from pathlib import Path
 
 from ..aero.atmosphere import isa, isa_ft
 from ..aero.indicial import wagner_set
-from ..errors import MAX_ELEMENTS, InputError, check_int, check_number, check_quantity
+from ..errors import (
+    MAX_ELEMENTS,
+    InputError,
+    check_int,
+    check_number,
+    check_quantity,
+    show_value,
+)
 from ..stability.matched import COMPRESSIBILITY
 from ..structure.wing import Actuator, ControlSurface, Segment, Wing, check_sweep
 from ..system.damping import NO_DAMPING, StructuralDamping
@@ -31,6 +39,7 @@ __all__ = [
     "wing_toml",
     "resolve_wing",
     "damping_from_dict",
+    "load_hinges",
 ]
 
 SEGMENT_KEYS = ("start", "end", "semichord", "a", "mass", "x_alpha", "inertia", "EI", "GJ")
@@ -118,7 +127,7 @@ def wing_from_dict(data: Mapping, where: str = "wing") -> Wing:
         vals = {k: check_number(f"{w}.{k}", seg[k]) for k in SEGMENT_KEYS}
         vals["sweep"] = segment_sweep(w, seg)
         segments.append(Segment(**vals, name=w))
-    surfaces = []
+    surfaces, taken = [], set()
     for i, cs in enumerate(
         _list_of_tables(f"{where}.control_surfaces", tbl.get("control_surfaces", []))
     ):
@@ -129,14 +138,13 @@ def wing_from_dict(data: Mapping, where: str = "wing") -> Wing:
         acts = []
         for j, act in enumerate(_list_of_tables(f"{w}.actuators", cs.get("actuators", []))):
             wa = f"{w}.actuators[{j}]"
-            _check_keys(wa, act, ACTUATOR_KEYS)
-            acts.append(
-                Actuator(
-                    station=check_number(f"{wa}.station", act["station"], unit="m"),
-                    stiffness=check_number(f"{wa}.stiffness", act["stiffness"], unit="N m/rad"),
-                    name=wa,
-                )
+            _check_keys(wa, act, ACTUATOR_KEYS, ("name",))
+            a = Actuator(
+                station=check_number(f"{wa}.station", act["station"], unit="m"),
+                stiffness=check_number(f"{wa}.stiffness", act["stiffness"], unit="N m/rad"),
+                name=wa,  # its key path in the messages of the checks
             )
+            acts.append(replace(a, name=_actuator_name(wa, act, taken)))
         nums = {
             k: check_number(f"{w}.{k}", cs[k])
             for k in ("start", "end", "hinge", "static_moment", "inertia", "GJ", "hinge_stiffness")
@@ -152,6 +160,24 @@ def wing_from_dict(data: Mapping, where: str = "wing") -> Wing:
         name=name,
         masses=masses,
     )
+
+
+def _actuator_name(where: str, act: Mapping, taken: set) -> str:
+    """An actuator's ``name`` (letters, digits and underscores: it names signals such as
+    ``<actuator>_rotation``), default ``actuator<k>`` numbered along the wing from 1."""
+    name = act.get("name", f"actuator{len(taken) + 1}")
+    if not isinstance(name, str) or not _SIGNAL_NAME.fullmatch(name):
+        raise InputError(
+            f"{where}.name = {show_value(name)}: expected a name of letters, digits and "
+            "underscores (it names signals such as <actuator>_rotation)"
+        )
+    if name in taken:
+        raise InputError(f"{where}.name = {name!r}: another actuator of the wing has this name")
+    taken.add(name)
+    return name
+
+
+_SIGNAL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 
 
 def segment_sweep(where: str, seg: Mapping) -> float:
@@ -251,7 +277,7 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
     data = read_toml(path, "wing file (TOML)")
     path = Path(path)
     try:
-        _check_keys("(top level)", data, ("wing",), ("analysis", "damping"))
+        _check_keys("(top level)", data, ("wing",), ("analysis", "damping", "hinges"))
         opts = analysis_from_dict(data.get("analysis", {}))
         if "damping" in data:
             with warnings.catch_warnings(record=True) as caught:
@@ -259,9 +285,42 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
                 opts = replace(opts, damping=damping_from_dict(data["damping"]))
             for w in caught:  # the file's name in front of the key
                 warnings.warn(f"{path}: {w.message}", w.category, stacklevel=2)
-        return wing_from_dict(data["wing"]), opts
+        wing = wing_from_dict(data["wing"])
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
+    if "hinges" in data:  # checked here too: a wrong table is found whatever reads the file
+        _hinges(data["hinges"], wing, str(path))
+    return wing, opts
+
+
+def _hinges(items: object, wing: Wing, file: str) -> tuple:
+    from .hinge_tables import check_targets, hinges_from_list
+
+    hinges = hinges_from_list(items, file)
+    check_targets(hinges, wing, file)
+    return hinges
+
+
+def load_hinges(path: str | Path) -> tuple:
+    """The nonlinear hinges of a wing file's top-level ``[[hinges]]`` tables (keys in
+    ``docs/wing-file.md``; :mod:`aeroservo.files.hinge_tables`), checked against its wing.
+
+    The linear analyses of the wing (flutter, simulations) keep every spring closed and do not
+    read them; limit-cycle studies (``kind = "lco"`` scenarios) do.
+
+    Parameters
+    ----------
+    path : str or Path
+        The wing file (TOML).
+
+    Returns
+    -------
+    tuple of NonlinearHinge
+        Empty when the file has no ``[[hinges]]``.
+    """
+    wing, _opts = load_wing(path)
+    data = read_toml(path, "wing file (TOML)")
+    return _hinges(data["hinges"], wing, str(Path(path))) if "hinges" in data else ()
 
 
 def resolve_wing(spec: str | Path) -> tuple[Wing, AnalysisOptions]:
@@ -280,7 +339,8 @@ def resolve_wing(spec: str | Path) -> tuple[Wing, AnalysisOptions]:
 
 def wing_toml(wing: Wing) -> str:
     """The ``[wing]`` table of a wing file describing ``wing`` (read back by :func:`load_wing`;
-    numbers written with ``repr``, so the round trip is exact)."""
+    numbers written with ``repr``, so the round trip is exact; actuator names when they are
+    unique signal names other than the default ``actuator<k>``)."""
     import json
 
     def num(x: float) -> str:
@@ -292,6 +352,8 @@ def wing_toml(wing: Wing) -> str:
         lines += [f"{k} = {num(getattr(seg, k))}" for k in SEGMENT_KEYS]
         if seg.sweep != 0.0:
             lines.append(f"sweep = {num(seg.sweep)}")
+    names = [a.name for cs in wing.control_surfaces for a in cs.actuators]
+    named = len(set(names)) == len(names) and all(_SIGNAL_NAME.fullmatch(n) for n in names)
     for cs in wing.control_surfaces:
         lines += ["", "[[wing.control_surfaces]]", f"name = {json.dumps(cs.name)}"]
         keys = SURFACE_REQUIRED[1:] + ("GJ", "hinge_stiffness")
@@ -299,5 +361,7 @@ def wing_toml(wing: Wing) -> str:
         for act in cs.actuators:
             lines += ["", "[[wing.control_surfaces.actuators]]"]
             lines += [f"{k} = {num(getattr(act, k))}" for k in ACTUATOR_KEYS]
+            if named and act.name != f"actuator{names.index(act.name) + 1}":
+                lines.append(f"name = {json.dumps(act.name)}")  # not the default: kept
     lines += masses_toml(wing.masses)
     return "\n".join(lines) + "\n"

@@ -100,6 +100,34 @@ class DescribingBranches:
     names: tuple[str, ...] = ()
     others_stable: np.ndarray | None = None
 
+    @classmethod
+    def from_table(
+        cls, rows: list, *, gap: float | None, element: str, names: tuple = ()
+    ) -> DescribingBranches:
+        """The branches of :meth:`table`'s rows (e.g. read back from a result file); ``gap``,
+        ``element`` and ``names`` as the attributes (``names``: the columns of ``ratios``,
+        default those of the first row)."""
+        try:
+            names = tuple(names or ()) or (tuple(rows[0]["ratios"]) if rows else (element,))
+            ratios = [[float(r["ratios"][n]) for n in names] for r in rows]
+            others = [r["others_stable"] for r in rows]
+            return cls(
+                amplitude=np.array([r["amplitude_rad"] for r in rows], dtype=float),
+                speed=np.array([r["speed_m_s"] for r in rows], dtype=float),
+                frequency=np.array([r["frequency_hz"] for r in rows], dtype=float),
+                stable=np.array([bool(r["stable"]) for r in rows], dtype=bool),
+                branch=np.array([r["branch"] for r in rows], dtype=int),
+                ratios=np.array(ratios, dtype=float).reshape(len(rows), len(names)),
+                gap=None if gap is None else float(gap),
+                element=str(element),
+                names=names,
+                others_stable=None
+                if rows and any(o is None for o in others)
+                else np.array([bool(o) for o in others], dtype=bool),
+            )
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise InputError(f"describing-function table: not valid ({exc!r:.80})") from None
+
     def onset(self) -> float:
         """Lowest speed [m/s] of any LCO branch (NaN without a branch)."""
         return float(self.speed.min()) if self.speed.size else float("nan")

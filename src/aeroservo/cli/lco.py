@@ -1,0 +1,121 @@
+"""The ``lco`` command: limit-cycle oscillations of an ``lco`` scenario (a wing or a typical
+section with nonlinear hinges, open or closed loop) over its speeds and initial rotations (in
+this process or on Dask), written as one set of files; and the redrawing of a saved result
+(``aeroservo plot RESULT.json``)."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import InputError
+from .loads import _workers
+
+__all__ = ["add_parsers", "HANDLERS", "run_lco_loaded", "plot_saved", "LCO_KINDS"]
+
+LCO_KINDS = ("bifurcation", "histories")
+"""The figures of a saved limit-cycle result (``aeroservo plot --kind``)."""
+
+
+def add_parsers(sub) -> None:
+    """The parser of ``lco``."""
+    helptext = "limit cycles of nonlinear hinges (freeplay, bilinear, cubic): an lco scenario"
+    r = sub.add_parser(
+        "lco",
+        help=helptext,
+        description="March a wing or a typical section with nonlinear hinges from rest with each "
+        "initial rotation at each speed of an lco scenario, and along the speeds up and down "
+        "(continuation), open loop or with its controller held fixed; judge each march (limit "
+        "cycle, decay, divergence) and compare with the describing function. Writes "
+        "RESULT.json, .csv, _branches.csv, _histories.npz, _summary.txt and the figures "
+        "_bifurcation.png and _histories.png into --out (all or none); 'aeroservo plot "
+        "DIR/RESULT.json' redraws them.",
+    )
+    r.add_argument("scenario", help="scenario file (.toml, kind = 'lco'), docs/scenarios.md")
+    r.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
+    r.add_argument("--json", action="store_true", help="print the summary as JSON")
+    r.add_argument(
+        "--quick",
+        action="store_true",
+        help="fast settings for smoke tests (3 speeds, 2 initial rotations, 2 s marches, no "
+        "describing function)",
+    )
+    r.add_argument("--no-plots", action="store_true", help="write the data files only")
+    r.add_argument(
+        "--quiet",
+        dest="progress",
+        action="store_false",
+        default=None,
+        help="no progress bar (default: a progress bar on stderr when it is a terminal)",
+    )
+    where = r.add_mutually_exclusive_group()
+    where.add_argument(
+        "--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://host:port"
+    )
+    where.add_argument(
+        "--workers",
+        type=_workers,
+        metavar="N",
+        help="local Dask workers, 0 in this process (default: lco.workers)",
+    )
+
+
+def _cmd_lco(args: argparse.Namespace) -> int:
+    from ..files.scenario_file import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    if scenario.kind != "lco":
+        use = {"flutter": "run", "gust_loads": "loads"}.get(scenario.kind, scenario.kind)
+        raise InputError(
+            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it"
+        )
+    return run_lco_loaded(scenario, args)
+
+
+def run_lco_loaded(scenario, args: argparse.Namespace) -> int:
+    """Run a loaded ``lco`` scenario with the options of ``lco`` (or of ``run``), write its
+    files and print its summary."""
+    from dataclasses import replace
+
+    from ..files.summaries import json_text
+    from ..studies.scenario import quick
+    from .options import run_into_folder
+
+    if args.quick:
+        scenario = quick(scenario)
+    if getattr(args, "no_plots", False):
+        scenario = replace(scenario, plots=False)
+    run, files = run_into_folder(scenario, args)
+    if args.json:
+        print(json_text(run.summary))
+        return 0
+    print(f"{scenario.name} [lco]")
+    print(run.lco.summary_text())
+    for kind, path in files.items():
+        print(f"  wrote {kind}: {path}")
+    return 0
+
+
+def plot_saved(res, src, args: argparse.Namespace, kind: str) -> int:
+    """The figures of a saved limit-cycle result: the bifurcation diagram and, when its NPZ
+    was next to it, the time histories, next to the result (as ``aeroservo lco`` names
+    them); or ``--kind`` alone (to ``--out``)."""
+    from pathlib import Path
+
+    from ..atomic import save_figure
+    from ..studies.lco_scenario import lco_figures
+
+    which = LCO_KINDS if args.kind is None and args.out is None else (kind,)
+    figs = lco_figures(res, which)
+    if not figs:
+        raise InputError(
+            f"--kind = {kind!r}: {args.result} has no time histories (its "
+            f"{Path(args.result).stem}_histories.npz is not next to it)"
+        )
+    for name, fig in figs.items():
+        out = Path(args.out) if args.out else src.with_name(f"{src.stem}_{name}.png")
+        save_figure(fig, out, dpi=130)
+        print(f"plot written to {out}")
+    return 0
+
+
+HANDLERS = {"lco": _cmd_lco}

@@ -1,0 +1,260 @@
+"""Limit-cycle result files: an :class:`~aeroservo.studies.lco_result.LCOResult` as
+``<stem>.json`` (the run's summary, the study's settings, every march's verdict without its
+time history, the describing-function branches and the summary text), ``<stem>_histories.npz``
+(the end of each march: ``row<i>/t`` [s] and ``row<i>/<signal>``, rows numbered as in the
+JSON), the table ``<stem>.csv`` (units in the header), the branches ``<stem>_branches.csv`` and
+the text ``<stem>_summary.txt``. :func:`load_lco` reads the JSON (and the NPZ when it is next to
+it) back into an equal result; the figures redraw from it. No pickled objects: a damaged or
+foreign file is one :class:`~aeroservo.errors.InputError`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from ..atomic import atomic_write_set
+from ..errors import InputError
+from ..studies.lco_result import TABLE_COLUMNS, LCOResult
+from .summaries import json_text
+from .user_files import MAX_RESULT_BYTES, read_bytes, user_path
+
+__all__ = ["FORMAT", "lco_items", "write_lco", "load_lco", "is_lco_file", "TABLE_UNITS"]
+
+FORMAT = "aeroservo-lco-1"
+
+TABLE_UNITS = {
+    "speed": "m/s",
+    "initial": "rad",
+    "frequency": "Hz",
+    "amplitude": "rad",
+    "rms": "rad",
+    "mean": "rad",
+    "amplitude_per_gap": "-",
+    "rms_per_gap": "-",
+    "growth": "1/s",
+    "switches_per_second": "1/s",
+}
+"""Units of the columns of the table (the others are text)."""
+
+_BRANCH_COLUMNS = (
+    ("branch", ""),
+    ("element", ""),
+    ("amplitude_rad", "amplitude [rad]"),
+    ("amplitude_per_gap", "amplitude_per_gap [-]"),
+    ("speed_m_s", "speed [m/s]"),
+    ("frequency_hz", "frequency [Hz]"),
+    ("stable", ""),
+    ("others_stable", ""),
+)
+
+
+def _header(name: str) -> str:
+    return f"{name} [{TABLE_UNITS[name]}]" if name in TABLE_UNITS else name
+
+
+def _csv_text(header: list, rows: list) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    w.writerows(rows)
+    return buf.getvalue()
+
+
+def table_csv(result: LCOResult) -> str:
+    """The CSV of :meth:`LCOResult.table` (one row per march; SI units, radians)."""
+    rows = [[r[k] for k in TABLE_COLUMNS] for r in result.table()]
+    return _csv_text([_header(k) for k in TABLE_COLUMNS], rows)
+
+
+def branches_csv(branches) -> str:
+    """The CSV of :meth:`DescribingBranches.table` (one row per LCO point)."""
+    table = branches.table()
+    names = list(branches.names) or list(table[0]["ratios"] if table else [])
+    head = [h or k for k, h in _BRANCH_COLUMNS] + [f"ratio_{n} [-]" for n in names]
+    rows = [[r[k] for k, _h in _BRANCH_COLUMNS] + [r["ratios"][n] for n in names] for r in table]
+    return _csv_text(head, rows)
+
+
+def _arrays(result: LCOResult) -> dict:
+    return {
+        f"row{i}/{k}": np.asarray(v)
+        for i, r in enumerate(result.rows)
+        for k, v in (r.get("history") or {}).items()
+    }
+
+
+def _doc(result: LCOResult, summary: dict, npz: Path | None) -> dict:
+    b = result.branches
+    return {
+        "format": FORMAT,
+        **summary,
+        "name": result.settings.get("name", ""),
+        "settings": dict(result.settings),
+        "arrays": None if npz is None else npz.name,
+        "rows": [{k: v for k, v in r.items() if k != "history"} for r in result.rows],
+        "branches": None
+        if b is None
+        else {"gap": b.gap, "element": b.element, "names": list(b.names), "table": b.table()},
+        "summary_text": result.summary_text(),
+    }
+
+
+def _text(make):
+    """A writer of the text ``make()`` (made when it writes)."""
+    return lambda p: p.write_text(make(), encoding="utf-8")
+
+
+def _npz_writer(arrays: dict):
+    def write(p: Path) -> None:
+        with open(p, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    return write
+
+
+def lco_items(result: LCOResult, json_path: str | Path, summary: dict) -> dict:
+    """The files of a result, ``{kind: (path, writer)}`` for
+    :func:`aeroservo.atomic.atomic_write_set`: ``summary`` (the JSON), ``table`` (the CSV),
+    ``branches`` (its CSV, when the result has describing-function branches), ``histories``
+    (the NPZ, when the marches kept histories) and ``summary_text``. The texts are made when
+    the writers run, so ``summary`` may still be completed (e.g. with the files written)."""
+    json_path = Path(json_path)
+    stem = json_path.with_suffix("")
+    arrays = _arrays(result)
+    npz = stem.parent / f"{stem.name}_histories.npz" if arrays else None
+    items = {
+        "summary": (json_path, _text(lambda: json_text(_doc(result, summary, npz)))),
+        "table": (stem.with_suffix(".csv"), _text(lambda: table_csv(result))),
+    }
+    if result.branches is not None:
+        path = stem.parent / f"{stem.name}_branches.csv"
+        items["branches"] = (path, _text(lambda: branches_csv(result.branches)))
+    if npz is not None:
+        items["histories"] = (npz, _npz_writer(arrays))
+    items["summary_text"] = (
+        stem.parent / f"{stem.name}_summary.txt",
+        _text(lambda: result.summary_text() + "\n"),
+    )
+    return items
+
+
+def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) -> dict[str, str]:
+    """Write a limit-cycle result (atomically, all files or none).
+
+    Parameters
+    ----------
+    result : LCOResult
+    path : str or Path
+        The ``.json`` file; the other files go next to it.
+    summary : dict, optional
+        The run's summary (default :func:`aeroservo.studies.lco_scenario.lco_summary`).
+
+    Returns
+    -------
+    dict
+        ``{kind: path}`` of the files written.
+    """
+    from ..studies.lco_scenario import lco_summary
+
+    if not isinstance(result, LCOResult):
+        raise InputError(f"result = {type(result).__name__}: expected an aeroservo LCOResult")
+    path = user_path(path, "limit-cycle result (.json)")
+    if path.suffix.lower() != ".json":
+        raise InputError(f"path = {str(path)!r}: expected a .json file name")
+    items = lco_items(result, path, summary or lco_summary(result))
+    atomic_write_set(list(items.values()))
+    return {k: str(p) for k, (p, _w) in items.items()}
+
+
+def is_lco_file(path: str | Path) -> bool:
+    """Whether ``path`` is a ``.json`` file written by :func:`write_lco` (its first
+    kilobytes name the format)."""
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        return False
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except (OSError, ValueError):
+        return False
+    return f'"format": "{FORMAT}"'.encode() in head
+
+
+def _fail(path: Path, what: str):
+    raise InputError(f"{path}: not a valid aeroservo limit-cycle result ({what})")
+
+
+def load_lco(path: str | Path) -> LCOResult:
+    """Read a result written by :func:`write_lco` (or ``aeroservo lco``): the JSON, and the
+    time histories from the NPZ it names when that file is next to it (without it the rows
+    have no history and only the bifurcation diagram redraws).
+
+    Raises
+    ------
+    InputError
+        The file is missing or not a limit-cycle result, or its NPZ is damaged.
+    """
+    from ..stability.describing_function import DescribingBranches
+
+    path = user_path(path, "limit-cycle result (.json)")
+    raw = read_bytes(path, what="limit-cycle result (.json)", limit=MAX_RESULT_BYTES)
+    try:
+        doc = json.loads(raw.decode("utf-8-sig"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        _fail(path, f"not JSON: {' '.join(str(exc).split())}")
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else None
+        _fail(path, f"format {found!r}, expected {FORMAT!r}")
+    rows, settings = doc.get("rows"), doc.get("settings")
+    if not isinstance(rows, list) or not all(
+        isinstance(r, dict) and all(k in r for k in TABLE_COLUMNS) for r in rows
+    ):
+        _fail(path, f"'rows' must be a list of marches with {list(TABLE_COLUMNS)}")
+    if not isinstance(settings, dict):
+        _fail(path, "'settings' must be a table")
+    branches = None
+    b = doc.get("branches")
+    if b is not None:
+        if not isinstance(b, dict) or not isinstance(b.get("table"), list):
+            _fail(path, "'branches' must be a table with a 'table' list")
+        try:
+            branches = DescribingBranches.from_table(
+                b["table"], gap=b.get("gap"), element=b.get("element", ""), names=b.get("names")
+            )
+        except InputError as exc:
+            _fail(path, str(exc))
+    hist = _histories(path, doc.get("arrays"), len(rows))
+    out = [{**r, "history": hist.get(i, {})} for i, r in enumerate(rows)]
+    return LCOResult(out, settings, branches)
+
+
+def _histories(path: Path, name: object, n_rows: int) -> dict:
+    """``{row: {signal: array}}`` from the NPZ ``name`` next to ``path`` ({} if absent)."""
+    if name is None:
+        return {}
+    if not isinstance(name, str) or Path(name).name != name or not name.endswith(".npz"):
+        _fail(path, f"'arrays' = {name!r}: expected the name of a .npz file next to it")
+    npz = path.parent / name
+    if not npz.is_file():
+        return {}
+    raw = read_bytes(npz, what="limit-cycle histories (.npz)", limit=MAX_RESULT_BYTES)
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
+        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"{npz}: not a .npz archive of limit-cycle histories ({why})") from None
+    out: dict = {}
+    for key, v in arrays.items():
+        row, sep, signal = key.partition("/")
+        i = int(row[3:]) if row.startswith("row") and row[3:].isdigit() else -1
+        if not sep or not signal or not 0 <= i < n_rows or v.ndim != 1:
+            raise InputError(f"{npz}: array {key!r} is not a history of a row of {path.name}")
+        out.setdefault(i, {})[signal] = v
+    return out
