@@ -87,7 +87,8 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
     ax.set_ylabel(ylabel)
     s = result.settings
     ax.set_title(
-        f"{s.get('name', '')}: {s.get('reference', '')} ({'; '.join(s.get('laws', [])[:1])}), "
+        f"{s.get('scenario') or s.get('name', '')}: {s.get('reference', '')} "
+        f"({'; '.join(s.get('laws', [])[:1])}), "
         f"{s.get('controller', '')}",
         fontsize=10,
     )
@@ -115,11 +116,13 @@ def plot_histories(result, speeds=None, *, n: int = 4, signals=None):
     gap = result.gap
     fig = new_figure(figsize=(8.0, 1.9 * len(chosen) + 0.6))
     axes = fig.subplots(len(chosen), 1, sharex=True, squeeze=False)[:, 0]
+    freqs = [r["frequency"] for r in chosen if np.isfinite(r["frequency"]) and r["frequency"] > 0]
+    window = 6.0 / min(freqs) if freqs else np.inf  # six cycles of the slowest
     for ax, r in zip(axes, chosen, strict=True):
         h = r["history"]
         t = np.asarray(h["t"])
         f = r["frequency"]
-        keep = t >= t[-1] - (6.0 / f if np.isfinite(f) and f > 0 else np.inf)  # six cycles
+        keep = t >= t[-1] - window
         t = t[keep]
         y = np.asarray(h[f"{ref}_rotation"])[keep]
         ax.plot(t, y / gap if gap else np.degrees(y), color="tab:blue", lw=1.0)
@@ -137,5 +140,6 @@ def plot_histories(result, speeds=None, *, n: int = 4, signals=None):
             fontsize=9,
         )
     axes[-1].set_xlabel("time [s] (the last cycles of each march)")
-    fig.suptitle(f"{result.settings.get('name', '')}: {ref} (dotted: gap edges)", fontsize=10)
+    title = result.settings.get("scenario") or result.settings.get("name", "")
+    fig.suptitle(f"{title}: {ref} (dotted: gap edges)", fontsize=10)
     return fig

@@ -176,6 +176,13 @@ def describing_lines(result) -> list[str]:
         f"{b.speed[seen].min():.4g} to {b.speed[seen].max():.4g} m/s, "
         f"{b.frequency[seen].min():.3g}-{b.frequency[seen].max():.3g} Hz"
     ]
+    onset = result.onset()
+    if np.isfinite(onset) and b.speed[seen].min() < 0.9 * onset:
+        lines.append(
+            f"  it predicts limit cycles below {onset:.4g} m/s, where no march settles in one "
+            f"(down to {b.speed[seen].min():.4g} m/s): near the gap edges the motion is far "
+            "from the one harmonic it keeps"
+        )
     errs = []
     for r in result.lco_rows():
         hit = _branch_at(b, seen, r["speed"], r["frequency"])
