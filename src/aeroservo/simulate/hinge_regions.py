@@ -22,8 +22,16 @@ from ..errors import InputError
 
 __all__ = ["Regions", "piece_tables", "leaves"]
 
-_SUB = 24
-"""Sub-intervals on which a flagged sample interval is scanned for edge crossings."""
+_SUB = 16
+"""Sub-intervals on which a flagged sample interval is scanned for edge crossings (then the
+cubic Hermite interpolant of each sub-interval, from the exact values and rates, for grazes)."""
+_GRID = np.linspace(0.0, 1.0, _SUB + 1)
+_FINE = np.linspace(0.0, 1.0, 257)
+
+GRAZE_MARGIN = 0.05
+"""A sample is marched through its closed form whenever the cubic interpolant of a rotation
+comes within this fraction of the sample's motion (``|s1 - s0|`` plus the rates times the
+step) of an edge (:func:`leaves`)."""
 
 
 def piece_tables(elements) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -152,27 +160,34 @@ class Regions:
             rest = h - t
             y1 = _path(lam, y0, gam, np.array([rest]))[:, 0]
             v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
-            bracket = _quick(v0, v1, rest, lo_l, hi_l)
+            # just after a switch the rotation starts on an edge: scan (a return within the
+            # sample would not show at its ends)
+            bracket = _quick(v0, v1, rest, lo_l, hi_l) if t == 0.0 else False
             ends = None
             if bracket is None:  # no edge reached: the end of the interval
                 return (V @ y1).real, r
             if bracket:
+                cands = [bracket]
                 ends = (v0[bracket[2]], v1[bracket[2]])
             else:  # scan the interval
-                taus = np.linspace(0.0, rest, _SUB + 1)
+                taus = rest * _GRID
                 Y = _path(lam, y0, gam, taus)
                 s = (W @ Y).real
-                bracket = _first_exit(s, taus, lo, hi, tol)
-                if bracket is None:
+                cands = _exits(s, taus, lo, hi, tol)
+                if not cands:
                     j = _graze(s, (Wd @ Y).real, taus, lo, hi, tol)
                     if j is not None:
-                        fine = np.linspace(taus[j - 1], taus[j], 257)
-                        bracket = _first_exit(_rot(W, lam, y0, gam, fine), fine, lo, hi, tol)
-                if bracket is None:
+                        fine = taus[j - 1] + (taus[j] - taus[j - 1]) * _FINE
+                        cands = _exits(_rot(W, lam, y0, gam, fine), fine, lo, hi, tol)
+                if not cands:
                     return (V @ y1).real, r
-            ta, tb, e, upper = bracket
-            edge = hi[e] if upper else lo[e]
-            tc = _crossing(W[e], lam, y0, gam, edge, ta, tb, tol[e], ends)
+            best = None  # the earliest crossing of every element out at the first exit
+            for ta, tb, e, upper in cands:
+                edge = hi[e] if upper else lo[e]
+                tc = _crossing(W[e], lam, y0, gam, edge, ta, tb, tol[e], ends)
+                if best is None or tc < best[0]:
+                    best = (tc, e, upper)
+            tc, e, upper = best
             x = _state(V, lam, y0, gam, tc)
             t += tc
             switches.append(t0 + t)
@@ -197,19 +212,18 @@ def _turns(s0: float, s1: float, r0: float, r1: float) -> int:
     return sum(0.0 < t < 1.0 for t in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)))
 
 
-def _first_exit(s, taus, lo, hi, tol):
-    """``(t_a, t_b, element, upper)`` of the first sample beyond an edge (not the first; upper:
-    beyond the upper edge), or None."""
+def _exits(s, taus, lo, hi, tol) -> list:
+    """``[(t_a, t_b, element, upper), ...]`` for every element beyond an edge at the first
+    sample (not the first) where any is, or []."""
     below = s < (lo - tol)[:, None]
     above = s > (hi + tol)[:, None]
     out = below | above
     out[:, 0] = False
     cols = np.flatnonzero(out.any(axis=0))
     if cols.size == 0:
-        return None
+        return []
     j = int(cols[0])
-    e = int(np.flatnonzero(out[:, j])[0])
-    return taus[j - 1], taus[j], e, not below[e, j]
+    return [(taus[j - 1], taus[j], int(e), not below[e, j]) for e in np.flatnonzero(out[:, j])]
 
 
 def _quick(v0: list, v1: list, rest: float, lo: list, hi: list):
@@ -239,7 +253,7 @@ def _crossing(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
     to rounding. A start within ``atol`` of the edge (the rotation has just crossed it) looks
     for the next crossing after its excursion into the region. ``ends``: the rotations at
     ``ta`` and ``tb`` when known."""
-    if np.abs(lam).min() > 1e-6:
+    if _far_from_zero(lam):
         off = gam / lam
         wa = w * (y0 + off)
         wl = wa * lam
@@ -266,7 +280,7 @@ def _crossing(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
         return tb
     if abs(fa) <= atol:  # on the edge at the start (just switched): the crossing after it
         for n in (32, 512):
-            grid = np.linspace(ta, tb, n + 1)[1:]
+            grid = ta + (tb - ta) * np.arange(1, n + 1) / n
             vals = fs(grid)
             inside = np.flatnonzero(np.sign(vals) == -np.sign(fb))
             if inside.size:
@@ -318,11 +332,27 @@ def _phi1(lam: np.ndarray, taus: np.ndarray) -> np.ndarray:
 def _path(lam, y0, gam, taus) -> np.ndarray:
     """Modal coordinates ``y(tau) = exp(lambda tau) y0 + phi1(lambda, tau) gamma``, (n, n_tau);
     as ``exp(lambda tau) (y0 + gamma/lambda) - gamma/lambda`` when no eigenvalue is near 0."""
-    ex = np.exp(np.multiply.outer(lam, taus))
-    if np.abs(lam).min() > 1e-6:
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging march: inf, reported
+        ex = np.exp(np.multiply.outer(lam, taus))
+    if _far_from_zero(lam):
         off = gam / lam
         return ex * (y0 + off)[:, None] - off[:, None]
     return ex * y0[:, None] + _phi1(lam, taus) * gam[:, None]
+
+
+_SAFE: dict = {}
+
+
+def _far_from_zero(lam: np.ndarray) -> bool:
+    """Whether no eigenvalue is within 1e-6 1/s of zero (cached per eigenvalue array)."""
+    key = id(lam)
+    hit = _SAFE.get(key)
+    if hit is None or hit[0] is not lam:
+        hit = _SAFE[key] = (lam, bool(np.abs(lam).min() > 1e-6))
+        if len(_SAFE) > 256:
+            _SAFE.clear()
+            _SAFE[key] = hit
+    return hit[1]
 
 
 def _rot(W, lam, y0, gam, taus) -> np.ndarray:
@@ -356,31 +386,32 @@ def _graze(s, sd, taus, lo, hi, tol):
 
 
 def leaves(v0, v1, e, lo, hi, dt) -> bool:
-    """Whether a rotation ends the sample beyond an edge of its piece, or turns within the
-    sample (rates of opposite signs at the ends) and its cubic Hermite interpolant reaches
-    beyond an edge (a graze). Python floats: ``e`` is a handful of elements."""
+    """Whether a rotation may reach an edge of its piece within a sample: it ends beyond one,
+    or the cubic Hermite interpolant of its values and rates at the ends comes within
+    :data:`GRAZE_MARGIN` of the sample's motion of one (a graze the ends do not show; the
+    margin covers the content the cubic misses, up to the sample rate). Python floats: ``e``
+    is a handful of elements."""
     for j in range(e):
-        s1 = v1[j]
+        s0, s1 = v0[j], v1[j]
         if s1 < lo[j] or s1 > hi[j]:
             return True
         d0, d1 = v0[e + j] * dt, v1[e + j] * dt
-        if d0 * d1 < 0.0:
-            s0 = v0[j]
-            # p(t) = s0 + d0 t + a t^2 + b t^3 on [0, 1]; p'(t) = 0 at the turning point
-            a = 3.0 * (s1 - s0) - 2.0 * d0 - d1
-            b = 2.0 * (s0 - s1) + d0 + d1
-            qa, qb, qc = 3.0 * b, 2.0 * a, d0
-            if qa == 0.0:
-                roots = [-qc / qb] if qb else []
-            else:
-                disc = qb * qb - 4.0 * qa * qc
-                if disc < 0.0:
-                    continue
-                sq = disc**0.5
-                roots = [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)]
-            for t in roots:
-                if 0.0 < t < 1.0:
-                    p = s0 + t * (d0 + t * (a + t * b))
-                    if p < lo[j] or p > hi[j]:
-                        return True
+        # p(t) = s0 + d0 t + a t^2 + b t^3 on [0, 1]; its extremes at the ends or p'(t) = 0
+        a = 3.0 * (s1 - s0) - 2.0 * d0 - d1
+        b = 2.0 * (s0 - s1) + d0 + d1
+        m = GRAZE_MARGIN * (abs(d0) + abs(d1) + abs(s1 - s0))
+        low, high = min(s0, s1) - m, max(s0, s1) + m
+        qa, qb, qc = 3.0 * b, 2.0 * a, d0
+        if qa == 0.0:
+            roots = [-qc / qb] if qb else []
+        else:
+            disc = qb * qb - 4.0 * qa * qc
+            sq = disc**0.5 if disc >= 0.0 else 0.0
+            roots = [(-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)] if disc >= 0.0 else []
+        for t in roots:
+            if 0.0 < t < 1.0:
+                p = s0 + t * (d0 + t * (a + t * b))
+                low, high = min(low, p - m), max(high, p + m)
+        if low < lo[j] or high > hi[j]:
+            return True
     return False

@@ -15,10 +15,15 @@ from scipy.integrate import solve_ivp
 from ..errors import InputError
 from .stepping import _checked
 
-__all__ = ["march_smooth", "RTOL"]
+__all__ = ["march_smooth", "RTOL", "DivergedMarch"]
 
 RTOL = 1e-10
 """Relative tolerance of the integrator."""
+
+
+class DivergedMarch(InputError):
+    """The integrator could not go on: the motion diverged (a softening spring beyond its
+    stiffness limit)."""
 
 
 def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, rate_dt, delay):
@@ -41,7 +46,7 @@ def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, 
             rhs, (0.0, t_span[-1]), x, method="DOP853", t_eval=t_span, rtol=RTOL, atol=atol,
             args=(np.zeros(n),),
         )  # fmt: skip
-        _check(sol, 0.0)
+        _check(sol)
         X[:] = sol.y.T
         return X, U, Cmd, []
     h, pending = np.zeros(m), np.zeros(m)
@@ -75,9 +80,10 @@ def march_smooth(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, mag, 
     return X, U, Cmd, []
 
 
-def _check(sol, t0: float) -> None:
+def _check(sol, t0: float = 0.0) -> None:
     if not sol.success or not np.all(np.isfinite(sol.y)):
-        raise InputError(
-            f"nonlinear march: the integrator failed after t = {t0:g} s ({sol.message}); a "
-            "softening spring beyond its stiffness limit diverges"
+        t_end = t0 + float(sol.t[-1]) if len(sol.t) else t0
+        raise DivergedMarch(
+            f"nonlinear march: the motion diverges after t = {t_end:.6g} s (the integrator "
+            f"stopped: {sol.message}); a softening spring beyond its stiffness limit?"
         )

@@ -22,6 +22,7 @@ import numpy as np
 from ..design.plant import Limits
 from ..errors import InputError, check_number
 from ..simulate.hinge_march import march_hinges
+from ..simulate.hinge_smooth import DivergedMarch
 from ..simulate.lco_detect import classify
 from ..system.hinge_elements import NonlinearHinge, hinge_elements
 
@@ -173,11 +174,15 @@ def march_task(shared: tuple, task: tuple) -> list[dict]:
                 plant, setup.controller, duration=sweep.duration, dt=sweep.dt,
                 limits=setup.limits, **kw,
             )  # fmt: skip
-        except InputError as exc:
-            rows.append(_failed(kind, v, amp, str(exc)))
+        except DivergedMarch as exc:  # the integrator of a smooth law gave up: diverged
+            rows.append(_failed(kind, v, amp if x is None else np.nan, str(exc), "divergence"))
             x = None
             continue
-        rows.append(_row(setup, sweep, kind, v, amp, res))
+        except InputError as exc:
+            rows.append(_failed(kind, v, amp if x is None else np.nan, str(exc)))
+            x = None
+            continue
+        rows.append(_row(setup, sweep, kind, v, amp if x is None else np.nan, res))
         x = res.states[-1] if np.all(np.isfinite(res.states[-1])) else None
         if x is not None and rows[-1]["kind"] == "divergence":
             x = None  # do not carry a diverged state on: restart the sweep from rest
@@ -236,12 +241,12 @@ def _centre(setup) -> float:
     return float(getattr(setup.elements.laws[0], "offset", 0.0))
 
 
-def _failed(kind, speed, amp, reason) -> dict:
+def _failed(kind, speed, amp, reason, verdict: str = "failed") -> dict:
     return {
         "start": kind,
         "speed": float(speed),
         "initial": float(amp),
-        "kind": "failed",
+        "kind": verdict,
         "confidence": "high",
         "reason": reason,
         "frequency": float("nan"),

@@ -38,7 +38,11 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
         ax = new_figure(figsize=(10.0, 5.0)).add_subplot()
     k, ylabel = _scale(result, per_gap)
     rows = result.rows
-    finite = [r["amplitude"] * k for r in rows if r["kind"] == "lco"]
+    finite = [
+        r["amplitude"] * k
+        for r in rows
+        if r["kind"] in ("lco", "growing", "aperiodic", "undecided") and np.isfinite(r["amplitude"])
+    ]
     top = 1.15 * max(finite + [1.0 if per_gap and result.gap else 1e-3])
     amps = sorted({r["initial"] for r in rows if r["start"] == "point"})
     cmap = __import__("matplotlib").colormaps["viridis"]

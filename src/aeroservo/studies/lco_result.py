@@ -37,7 +37,8 @@ class LCOResult:
     ----------
     rows : list of dict
         One per march: ``start`` ("point", "up" or "down"), ``speed`` [m/s], ``initial``
-        rotation [rad], ``kind`` (lco, decay, divergence, aperiodic, undecided, failed),
+        rotation [rad] (nan for a sweep's march that starts from the state carried on),
+        ``kind`` (lco, decay, growing, divergence, aperiodic, undecided, failed),
         ``confidence``, ``reason``, ``frequency`` [Hz], ``amplitude`` and ``rms`` [rad] of the
         reference rotation, per gap, ``peaks``/``rmss`` of every recorded signal, and
         ``history`` (the end of the march).
