@@ -26,6 +26,14 @@ _SUB = 16
 """Sub-intervals on which a flagged sample interval is scanned for edge crossings (then the
 cubic Hermite interpolant of each sub-interval, from the exact values and rates, for grazes)."""
 _GRID = np.linspace(0.0, 1.0, _SUB + 1)
+_TH = np.linspace(0.0, 1.0, 33)[:, None]
+_HERMITE = (
+    2 * _TH**3 - 3 * _TH**2 + 1,
+    _TH**3 - 2 * _TH**2 + _TH,
+    -2 * _TH**3 + 3 * _TH**2,
+    _TH**3 - _TH**2,
+)
+"""The cubic Hermite basis at 33 points of a sub-interval (graze test)."""
 _FINE = np.linspace(0.0, 1.0, 257)
 
 GRAZE_MARGIN = 0.05
@@ -368,9 +376,7 @@ def _graze(s, sd, taus, lo, hi, tol):
     """Index of the first sub-interval whose cubic Hermite interpolant of a rotation (from its
     values and rates at the ends) leaves the piece, or None."""
     dt = np.diff(taus)
-    th = np.linspace(0.0, 1.0, 33)[:, None]
-    h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
-    h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+    h00, h10, h01, h11 = _HERMITE
     first = None
     for e in range(s.shape[0]):
         d0, d1 = sd[e, :-1] * dt, sd[e, 1:] * dt
