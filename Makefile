@@ -41,6 +41,7 @@ bench: install
 	$(BIN)/python bench/bench_mpc_step.py
 	$(BIN)/python bench/bench_trade.py
 	$(BIN)/python bench/bench_gust_loads.py
+	$(BIN)/python bench/bench_lco.py
 
 # a few minutes: the issue-17 targets with fewer repeats (CI runs it as a smoke test that
 # reports and does not gate on timing: tests/test_bench.py)

@@ -24,17 +24,9 @@ import sys
 import time
 
 import scipy.linalg as sla
+from _timing import median
 
 import aeroservo as aes
-
-
-def median_time(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def in_process(n_elements: int, repeats: int) -> dict:
@@ -51,8 +43,8 @@ def in_process(n_elements: int, repeats: int) -> dict:
     eig = blas_limited(sla.eig)
     t_fb, t_eig, ratios = [], [], []
     for _ in range(repeats):
-        t_fb.append(median_time(lambda: aes.flutter_boundary(model, 1.225), 1))
-        t_eig.append(median_time(lambda: eig(a), 5 if n_elements <= 20 else 1))
+        t_fb.append(median(lambda: aes.flutter_boundary(model, 1.225), 1))
+        t_eig.append(median(lambda: eig(a), 5 if n_elements <= 20 else 1))
         ratios.append(t_fb[-1] / t_eig[-1])
     return {
         "elements": n_elements,
@@ -79,9 +71,9 @@ def envelope_cost(quick: bool) -> dict:
 
     one()
     return {
-        "one_s": median_time(one, 3 if quick else 5),
-        "env_s": median_time(lambda: env(None), 1 if quick else 3),
-        "env_pg_s": None if quick else median_time(lambda: env("prandtl-glauert"), 1),
+        "one_s": median(one, 3 if quick else 5),
+        "env_s": median(lambda: env(None), 1 if quick else 3),
+        "env_pg_s": None if quick else median(lambda: env("prandtl-glauert"), 1),
     }
 
 
@@ -92,8 +84,8 @@ def sensitivity_cost(quick: bool) -> dict:
     flutter_sensitivities(model, 1.225)  # warm-up
     ratios = []
     for _ in range(3 if quick else 9):
-        one = median_time(lambda: aes.flutter_boundary(model, 1.225), 1)
-        sens = median_time(lambda: flutter_sensitivities(model, 1.225), 1)
+        one = median(lambda: aes.flutter_boundary(model, 1.225), 1)
+        sens = median(lambda: flutter_sensitivities(model, 1.225), 1)
         ratios.append(sens / one)
     n = len(flutter_sensitivities(model, 1.225).values)
     return {"ratio": statistics.median(ratios), "n": n, "one_s": one}

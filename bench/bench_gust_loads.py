@@ -13,10 +13,10 @@ Goland wing with aileron, 10 elements, sea level, 0.9 V_f, the LQR loop of
 from __future__ import annotations
 
 import inspect
-import statistics
 import sys
-import time
 from pathlib import Path
+
+from _timing import median
 
 from aeroservo.files.scenario_file import load_scenario
 from aeroservo.stability.boundary import flutter_boundary
@@ -31,15 +31,6 @@ LOADS = [
     "tip_te_accel",
     "aileron_aero_hinge_moment",
 ]
-
-
-def median(fn, n: int) -> float:
-    out = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return statistics.median(out)
 
 
 def main() -> None:

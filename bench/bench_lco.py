@@ -17,12 +17,12 @@ the LQR loop of ``scenarios/goland_aileron_lqr.toml`` (1 kHz, actuator limits):
 
 from __future__ import annotations
 
-import statistics
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _timing import median
 
 from aeroservo.design.hinge_loop import loop_hinge_plant
 from aeroservo.files.scenario_file import load_scenario
@@ -35,15 +35,6 @@ from aeroservo.studies.lco_run import run_lco
 from aeroservo.system.hinge_elements import NonlinearHinge
 
 GAP = float(np.radians(1.0))
-
-
-def median(fn, n: int) -> float:
-    out = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return statistics.median(out)
 
 
 def main() -> None:

@@ -7,22 +7,13 @@
 
 from __future__ import annotations
 
-import statistics
 import time
 
 import numpy as np
 import scipy.linalg as sla
+from _timing import median
 
 import aeroservo as aes
-
-
-def median(fn, n):
-    out = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return statistics.median(out)
 
 
 def main() -> None:
