@@ -418,7 +418,7 @@ def test_a_graze_within_a_sample_is_found(goland, excess):
     for 1e-6; 0.9161, 1.2759, 1.4300 ms for 1e-2). The march at 1 ms finds the first crossing
     only and keeps the spring engaged while the rotation is back in the gap (state error 1.5e-4
     and 1e-5 of the peak): for 1e-6 the return follows the switch within the sample (the test
-    from the interval's ends, ``_quick``, is trusted right after a switch); for 1e-2 the return
+    from the interval's ends, ``quick_bracket``, is trusted right after a switch); for 1e-2 the return
     and the exit fall in the next sample, whose ends-only Hermite test (``leaves``) misses
     them."""
     gap = 2 * PEAK / (1 + excess)

@@ -80,6 +80,14 @@ def run_lco_loaded(scenario, args: argparse.Namespace) -> int:
     from ..studies.scenario import quick
     from .options import run_into_folder
 
+    workers, scheduler = getattr(args, "workers", None), getattr(args, "scheduler", None)
+    if workers is not None and scheduler is not None:  # 'aeroservo run' takes both
+        raise InputError(
+            f"--workers = {workers} and --scheduler = {scheduler!r}: give one (local workers "
+            "or a running Dask scheduler)"
+        )
+    if workers is not None and not 0 <= workers <= 256:
+        raise InputError(f"--workers = {workers}: allowed range is [0, 256]")
     if args.quick:
         scenario = quick(scenario)
     if getattr(args, "no_plots", False):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import zipfile
 from pathlib import Path
 
@@ -218,6 +219,8 @@ def load_lco(path: str | Path) -> LCOResult:
         _fail(path, f"'rows' must be a list of marches with {list(TABLE_COLUMNS)}")
     if not isinstance(settings, dict):
         _fail(path, "'settings' must be a table")
+    _check_settings(path, settings)
+    rows = [_checked_row(path, i, r) for i, r in enumerate(rows)]
     branches = None
     b = doc.get("branches")
     if b is not None:
@@ -229,13 +232,71 @@ def load_lco(path: str | Path) -> LCOResult:
             )
         except InputError as exc:
             _fail(path, str(exc))
-    hist = _histories(path, doc.get("arrays"), len(rows))
+    hist = _histories(path, doc.get("arrays"), len(rows), settings.get("reference"))
     out = [{**r, "history": hist.get(i, {})} for i, r in enumerate(rows)]
     return LCOResult(out, settings, branches)
 
 
-def _histories(path: Path, name: object, n_rows: int) -> dict:
-    """``{row: {signal: array}}`` from the NPZ ``name`` next to ``path`` ({} if absent)."""
+_ROW_TEXT = ("start", "kind", "confidence", "reason")
+_ROW_MAPS = ("peaks", "rmss", "saturated")
+_SETTINGS = {  # the settings the summary and the figures read: key -> type
+    **dict.fromkeys(("name", "scenario", "reference", "controller", "model"), str),
+    **dict.fromkeys(("duration", "dt", "settle", "density"), float),
+    **dict.fromkeys(("elements", "laws", "notes"), list),
+    "speeds": list,
+    "amplitudes": list,
+    "closed_loop": bool,
+}
+
+
+def _is_number(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _checked_row(path: Path, i: int, row: dict) -> dict:
+    """A row of the JSON with its types checked; a number written as null reads as NaN."""
+    out = dict(row)
+    for k in TABLE_COLUMNS + _ROW_MAPS:
+        v = row.get(k)
+        if k in _ROW_MAPS:
+            ok = v is None or (isinstance(v, dict) and all(map(_is_number, v.values())))
+        elif k in _ROW_TEXT:
+            ok = isinstance(v, str) and (k != "start" or v in ("point", "up", "down"))
+        elif v is None:
+            out[k], ok = float("nan"), k != "speed"
+        else:
+            ok = _is_number(v) and (k != "speed" or math.isfinite(v))
+        if not ok:
+            _fail(path, f"rows[{i}].{k} = {v!r}: not what aeroservo writes")
+    return out
+
+
+def _check_settings(path: Path, settings: dict) -> None:
+    """The settings the summary and the figures read, of the types aeroservo writes."""
+    for k, kind in _SETTINGS.items():
+        v = settings.get(k)
+        if v is None:
+            continue
+        if kind is float:
+            ok = _is_number(v)
+        elif kind is list:
+            item = str if k in ("elements", "laws", "notes") else (int, float)
+            ok = isinstance(v, list) and all(
+                isinstance(x, item) and not isinstance(x, bool) for x in v
+            )
+        else:
+            ok = isinstance(v, kind)
+        if not ok:
+            _fail(path, f"settings.{k} = {v!r}: not what aeroservo writes")
+    gap = settings.get("gap")
+    if gap is not None and not (_is_number(gap) and 0.0 < gap < math.inf):
+        _fail(path, f"settings.gap = {gap!r}: expected a positive gap [rad] or null")
+
+
+def _histories(path: Path, name: object, n_rows: int, reference: object = None) -> dict:
+    """``{row: {signal: array}}`` from the NPZ ``name`` next to ``path`` ({} if absent):
+    each row's arrays real, one-dimensional and as long as its ``t``, with the rotation and
+    hinge moment of the ``reference`` element."""
     if name is None:
         return {}
     if not isinstance(name, str) or Path(name).name != name or not name.endswith(".npz"):
@@ -256,5 +317,18 @@ def _histories(path: Path, name: object, n_rows: int) -> dict:
         i = int(row[3:]) if row.startswith("row") and row[3:].isdigit() else -1
         if not sep or not signal or not 0 <= i < n_rows or v.ndim != 1:
             raise InputError(f"{npz}: array {key!r} is not a history of a row of {path.name}")
+        if not (np.issubdtype(v.dtype, np.floating) or np.issubdtype(v.dtype, np.integer)):
+            raise InputError(f"{npz}: array {key!r} of {v.dtype} values: expected real numbers")
         out.setdefault(i, {})[signal] = v
+    need = ["t"] + ([f"{reference}_rotation", f"{reference}_hinge_moment"] if reference else [])
+    for i, h in out.items():
+        missing = [k for k in need if k not in h]
+        if missing:
+            raise InputError(f"{npz}: row{i}/{missing[0]}: missing (the history of row {i})")
+        bad = [k for k, v in h.items() if v.shape != h["t"].shape]
+        if bad:
+            raise InputError(
+                f"{npz}: row{i}/{bad[0]}: {h[bad[0]].size} values, its row{i}/t "
+                f"{h['t'].size}: not a history of {path.name}"
+            )
     return out

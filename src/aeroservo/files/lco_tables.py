@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..simulate.march import MAX_SAMPLES
+from ..simulate.hinge_march import MAX_HINGE_SAMPLES
 from ..studies.scenario import Scenario
 from .hinge_tables import check_targets, hinges_from_list
 from .scenario_tables import controller
@@ -66,6 +66,13 @@ UNUSED = {
 """Keys of the shared tables a limit-cycle scenario has no use for (an error, not ignored):
 the march length is ``lco.duration`` and the march has no computational delay."""
 
+_CLOSED_ONLY = (
+    ("simulation", "sample_rate", "the controller's rate; the open loop steps at lco.dt"),
+    ("model", "design_modes", "the controller's design model"),
+    ("model", "gust", "the gust input of the controller's design model"),
+)
+"""Keys only a closed loop uses: ``(table, key, why)``."""
+
 
 def section_table(top: Table, kw: dict) -> None:
     """``[section]``: ``builtin = "conner"`` (with ``damped``) or the parameters of a typical
@@ -100,6 +107,10 @@ def section_table(top: Table, kw: dict) -> None:
             return
         st.check_keys(tuple(k for k in SECTION_KEYS if k != "flap_static_moment"), SECTION_KEYS)
         vals = {k: st.number(k, unit=_UNITS.get(k, "")) for k in SECTION_KEYS if st.has(k)}
+        if vals["k_flap"] == 0.0:  # the nonlinear law scales this spring
+            st.fail(
+                "k_flap", 0.0, "the nonlinear hinge law acts on this spring (its k): give it > 0"
+            )
         kw["section"] = TypicalSection(**vals, wagner=wagner, damping=damping)
         kw["wing_source"] = "section"
     except InputError as exc:
@@ -112,7 +123,8 @@ def section_table(top: Table, kw: dict) -> None:
 def lco_tables(top: Table, base: Path, kw: dict) -> None:
     """Read ``[controller]`` and ``[lco]`` of a limit-cycle scenario into ``kw`` (the
     :class:`~aeroservo.studies.scenario.Scenario` keywords read so far). Without
-    ``controller.spec`` the study is open loop, and ``[flight]`` takes the density only."""
+    ``controller.spec`` (or with a controller of type ``"none"``) the study is open loop, and
+    ``[flight]`` takes the density only."""
     for name, keys in UNUSED.items():
         tbl = top.table(name)
         for key in keys:
@@ -122,24 +134,31 @@ def lco_tables(top: Table, base: Path, kw: dict) -> None:
     ct = top.table("controller").check_keys((), ("spec",))
     if ct.has("spec"):
         kw["controller"] = controller(ct, ct.path("spec", base, required=True))
-        if kw.get("speed") is None and kw.get("speed_factor") is None:
-            raise InputError(
-                f"{top.file}: flight.speed: missing; give speed [m/s] or speed_factor (x the "
-                "open-loop flutter speed): the controller's design point"
-            )
-    else:
+    closed = ct.has("spec") and kw["controller"].type != "none"
+    if closed and kw.get("speed") is None and kw.get("speed_factor") is None:
+        raise InputError(
+            f"{top.file}: flight.speed: missing; give speed [m/s] or speed_factor (x the "
+            "open-loop flutter speed): the controller's design point"
+        )
+    if not closed:
+        only = "only with controller.spec" + (
+            " of a type other than 'none'" if ct.has("spec") else ""
+        )
         for key in ("speed", "speed_factor"):
             if fl.has(key):
                 fl.fail(
                     key,
                     fl.data[key],
-                    "only with controller.spec (the controller's design speed); the study's "
-                    "speeds are lco.speeds",
+                    f"{only} (the controller's design speed); the study's speeds are lco.speeds",
                 )
         if top.has("signals"):
-            top.fail("signals", top.data["signals"], "only with controller.spec (the loop's)")
+            top.fail("signals", top.data["signals"], f"{only} (the loop's)")
+        for name, key, why in _CLOSED_ONLY:
+            tbl = top.table(name)
+            if tbl.has(key):
+                tbl.fail(key, tbl.data[key], f"{only} ({why})")
     lt = top.table("lco", required=True)
-    kw["lco"] = lco_table(lt, kw, closed=ct.has("spec"))
+    kw["lco"] = lco_table(lt, kw, closed=closed)
 
 
 def lco_table(lt: Table, kw: dict, closed: bool) -> dict:
@@ -167,12 +186,12 @@ def lco_table(lt: Table, kw: dict, closed: bool) -> dict:
         lt.fail("dt", lt.data["dt"], "the closed loop steps at 1/simulation.sample_rate")
     out["dt"] = lt.number("dt", 1e-3, unit="s", lo=1e-6, hi=0.1)
     step = 1.0 / kw["sample_rate"] if closed else out["dt"]
-    samples = round(out["duration"] / step) + 1
-    if samples > MAX_SAMPLES:
+    steps = round(out["duration"] / step)  # as the march counts them
+    if not 1 <= steps <= MAX_HINGE_SAMPLES:
         lt.fail(
             "duration",
             out["duration"],
-            f"{samples} samples of {step:g} s, above the limit of {MAX_SAMPLES} per march",
+            f"{steps} steps of {step:g} s; a march takes 1 to {MAX_HINGE_SAMPLES}",
         )
     out["settle"] = lt.number("settle", 0.5, lo=0.0, hi=0.9)
     out["continuation"] = lt.boolean("continuation", True)
@@ -246,6 +265,17 @@ def lco_cross_check(s: Scenario, top: Table) -> None:
     check_targets(lco["hinges"], s.wing, file, key)
     if s.controller is None or s.controller.type == "none":
         return
+    surfaces = {cs.name: [a.name for a in cs.actuators] for cs in s.wing.control_surfaces}
+    actuators = {a for acts in surfaces.values() for a in acts}
+    for i, h in enumerate(lco["hinges"]):  # as check_targets resolves them
+        for a in [h.target] if h.target in actuators else surfaces[h.target]:
+            if f"{a}_nonlinear_moment" in s.controls:
+                top.table("signals").fail(
+                    "controls",
+                    list(s.controls),
+                    f"'{a}_nonlinear_moment' is driven by the hinge law of {key}[{i}], not by "
+                    "a controller",
+                )
     model = s.model()
     check_loop_signals(s, s.wing, model, top)
     if s.sensor_filter is not None and s.sensor_filter >= 0.5 * s.sample_rate:

@@ -28,7 +28,8 @@ from ..design.plant import Limits
 from ..design.sampled_loop import linear_law, plant_states
 from ..errors import InputError, check_number
 from ..linear.signals import describe
-from .hinge_regions import Regions, leaves
+from .hinge_path import leaves
+from .hinge_regions import Regions
 from .result import SimulationResult
 from .stepping import _checked, _law_matrix
 

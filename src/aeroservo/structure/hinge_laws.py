@@ -97,9 +97,9 @@ class Freeplay:
         return _quadrature(self, a, k)
 
     def describe(self) -> str:
-        what = f"gap {np.degrees(self.gap):.4g} deg"
+        what = f"gap {self.gap:.4g} rad = {np.degrees(self.gap):.4g} deg"
         if self.offset:
-            what += f" centred at {np.degrees(self.offset):.4g} deg"
+            what += f" centred at {self.offset:.4g} rad"
         if self.inner_ratio:
             what += f", inner stiffness {self.inner_ratio:g} k"
         return f"{self.kind} ({what})"

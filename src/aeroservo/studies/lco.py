@@ -209,11 +209,12 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
     reach = float(np.max(np.abs(res.rotations[setup.reference] - _centre(setup))))
     if kind_ == "divergence" and gap and np.isfinite(reach) and reach < DIVERGED * gap:
         kind_ = "growing"  # not settled at the end of the march, and still moderate
-        where = "inside the gap" if reach < 0.5 * gap else "still moderate"
-        reason = (
-            f"grows, {where} (largest rotation {reach / gap:.3g} x gap): march longer to see "
-            "where it settles; " + reason
-        )
+        if reach < 0.5 * gap:
+            what = f"unstable inside the gap: grows, largest rotation {reach / gap:.3g} x gap"
+        else:
+            what = f"grows, largest rotation {reach / gap:.3g} x gap: march longer to see where"
+            what += " it settles"
+        reason = what + "; " + reason
     row = {
         "start": kind,
         "speed": float(speed),

@@ -131,6 +131,9 @@ def run_lco_scenario(
         "linear flutter speed, open loop with every spring closed: "
         + ("none in the searched range" if vf is None else f"{vf:.4g} m/s")
     )
+    coarse = _coarse_step(result)
+    if coarse:
+        notes.append(coarse)
     if not c["describing"]:
         notes.append("describing function: not computed (lco.describing = false)")
     if c.get("wing_hinges_replaced"):
@@ -141,6 +144,41 @@ def run_lco_scenario(
             f"{result.settings['design_speed']:.4g} m/s, held fixed at every speed"
         )
     return lco_summary(result, scenario), result
+
+
+MIN_SAMPLES_PER_CYCLE = 20
+"""Fewest steps per cycle of a march's motion before the run warns that its step is coarse
+(the march misses a rotation that crosses a gap edge and back within one step; at 10 per
+cycle the Conner section's verdicts lose confidence, at 4 they change)."""
+
+
+def _coarse_step(result) -> str:
+    """A note when the step of the marches resolves the motion they found with fewer than
+    :data:`MIN_SAMPLES_PER_CYCLE` steps per cycle ("" otherwise); motions below 1 % of the
+    gap (or of the smallest initial rotation) are left out (the noise of a march at rest)."""
+    s = result.settings
+    dt = s.get("dt")
+    scale = s.get("gap") or min(s.get("amplitudes") or [0.0])
+    found = [
+        (r["frequency"], r["speed"])
+        for r in result.rows
+        if math.isfinite(r["frequency"])
+        and r["frequency"] > 0
+        and math.isfinite(r["amplitude"])
+        and r["amplitude"] >= 0.01 * scale
+    ]
+    if not dt or not found:
+        return ""
+    f, v = max(found)
+    per_cycle = 1.0 / (f * dt)
+    if per_cycle >= MIN_SAMPLES_PER_CYCLE:
+        return ""
+    fix = "raise simulation.sample_rate" if s.get("closed_loop") else "lower lco.dt"
+    return (
+        f"step {dt:g} s coarse: {per_cycle:.3g} steps per cycle at {f:.3g} Hz ({v:.4g} m/s), "
+        f"below {MIN_SAMPLES_PER_CYCLE}; a rotation across a gap edge and back within one "
+        f"step is missed and a faster motion shows at an alias frequency: {fix} and run again"
+    )
 
 
 def _plain(v: object) -> object:
