@@ -452,11 +452,11 @@ def test_closed_loop_smoke(tmp_path, capsys):
     s = res.settings
     assert s["closed_loop"] and s["controller"].startswith("LQR (Bryson")
     assert s["design_speed"] == pytest.approx(1.1 * s["open_loop_flutter_speed"], rel=1e-12)
-    assert s["dt"] == pytest.approx(1e-3) and res.branches is None
+    assert s["dt"] == pytest.approx(1e-3) and res.branches is not None  # of the sampled loop
     assert len(res.rows) == 1 and res.rows[0]["kind"] != "failed"
     assert "actuator1_rotation" in res.rows[0]["history"]
     names = sorted(p.name for p in out.iterdir())
-    assert "goland_aileron_freeplay_lqr_branches.csv" not in names and len(names) == 6
+    assert "goland_aileron_freeplay_lqr_branches.csv" in names and len(names) == 7
     bad = path.read_text().replace("speed_factor = 1.1 ", "# no design speed")
     path.write_text(bad)
     assert main(["lco", str(path), "--out", str(tmp_path / "o2")]) == 2

@@ -61,24 +61,17 @@ def add_parsers(sub) -> None:
 
 def _cmd_lco(args: argparse.Namespace) -> int:
     from ..files.scenario_file import load_scenario
+    from .options import require_kind
 
     scenario = load_scenario(args.scenario)
-    if scenario.kind != "lco":
-        use = {"flutter": "run", "gust_loads": "loads"}.get(scenario.kind, scenario.kind)
-        raise InputError(
-            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it"
-        )
+    require_kind(scenario, args.scenario, "lco")
     return run_lco_loaded(scenario, args)
 
 
 def run_lco_loaded(scenario, args: argparse.Namespace) -> int:
     """Run a loaded ``lco`` scenario with the options of ``lco`` (or of ``run``), write its
     files and print its summary."""
-    from dataclasses import replace
-
-    from ..files.summaries import json_text
-    from ..studies.scenario import quick
-    from .options import run_into_folder
+    from .options import run_study
 
     workers, scheduler = getattr(args, "workers", None), getattr(args, "scheduler", None)
     if workers is not None and scheduler is not None:  # 'aeroservo run' takes both
@@ -88,19 +81,7 @@ def run_lco_loaded(scenario, args: argparse.Namespace) -> int:
         )
     if workers is not None and not 0 <= workers <= 256:
         raise InputError(f"--workers = {workers}: allowed range is [0, 256]")
-    if args.quick:
-        scenario = quick(scenario)
-    if getattr(args, "no_plots", False):
-        scenario = replace(scenario, plots=False)
-    run, files = run_into_folder(scenario, args)
-    if args.json:
-        print(json_text(run.summary))
-        return 0
-    print(f"{scenario.name} [lco]")
-    print(run.lco.summary_text())
-    for kind, path in files.items():
-        print(f"  wrote {kind}: {path}")
-    return 0
+    return run_study(scenario, args, lambda run: run.lco.summary_text())
 
 
 def plot_saved(res, src, args: argparse.Namespace, kind: str) -> int:

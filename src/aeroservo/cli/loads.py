@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..errors import InputError
-
 __all__ = ["add_parsers", "HANDLERS", "run_loaded"]
 
 
@@ -59,38 +57,19 @@ def add_parsers(sub) -> None:
 
 def _cmd_loads(args: argparse.Namespace) -> int:
     from ..files.scenario_file import load_scenario
+    from .options import require_kind
 
     scenario = load_scenario(args.scenario)
-    if scenario.kind != "gust_loads":
-        use = {"flutter": "run", "gust_loads": "loads"}.get(scenario.kind, scenario.kind)
-        raise InputError(
-            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it"
-        )
+    require_kind(scenario, args.scenario, "gust_loads")
     return run_loaded(scenario, args)
 
 
 def run_loaded(scenario, args: argparse.Namespace) -> int:
     """Run a loaded ``gust_loads`` scenario with the options of ``loads`` (or of ``run``), write
     its files and print its summary."""
-    from dataclasses import replace
+    from .options import run_study
 
-    from ..files.summaries import json_text
-    from ..studies.scenario import quick
-    from .options import run_into_folder
-
-    if args.quick:
-        scenario = quick(scenario)
-    if getattr(args, "no_plots", False):
-        scenario = replace(scenario, plots=False)
-    run, files = run_into_folder(scenario, args)
-    if args.json:
-        print(json_text(run.summary))
-        return 0
-    print(f"{scenario.name} [gust_loads]")
-    print(run.loads.summary_text())
-    for kind, path in files.items():
-        print(f"  wrote {kind}: {path}")
-    return 0
+    return run_study(scenario, args, lambda run: run.loads.summary_text())
 
 
 HANDLERS = {"loads": _cmd_loads}

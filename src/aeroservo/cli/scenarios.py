@@ -82,11 +82,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from ..studies.scenario import quick
 
     scenario = load_scenario(args.scenario)
-    if args.command != "run" and scenario.kind != args.command:
-        use = {"flutter": "run", "gust_loads": "loads"}.get(scenario.kind, scenario.kind)
-        raise InputError(
-            f"{args.scenario}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it"
-        )
+    if args.command != "run":
+        from .options import require_kind
+
+        require_kind(scenario, args.scenario, args.command)
     if scenario.kind == "gust_loads":  # 'aeroservo run': as 'aeroservo loads' does
         from .loads import run_loaded
 

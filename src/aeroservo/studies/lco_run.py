@@ -1,5 +1,6 @@
 """Run a limit-cycle study: every march in this process or on Dask, with a progress bar, and
-the describing-function prediction of the open loop."""
+the describing-function prediction (of the open loop, or of the sampled loop with its
+controller)."""
 
 from __future__ import annotations
 
@@ -39,7 +40,8 @@ def run_lco(
     timeout : float
         Time allowed for local workers to start [s].
     describing : bool
-        Add the describing-function branches (open loop, gaps centred at zero).
+        Add the describing-function branches (gaps centred at zero; with a controller, of its
+        sampled loop).
 
     Returns
     -------
@@ -108,37 +110,68 @@ def _describe(controller) -> str:
 
 
 def _describing(setup: LCOSetup, sweep: LCOSweep):
-    """The describing-function branches of the open loop, or None and a note why not."""
+    """The describing-function branches of the open loop, or of the sampled loop with
+    ``setup.controller`` (:func:`~aeroservo.design.hinge_describing.loop_describing_branches`),
+    or None and a note why not."""
     from ..stability.describing_function import describing_branches
 
-    if setup.controller is not None:
-        return None, (
-            "describing function: computed for the open loop only (the sampled controller "
-            "is not part of the equivalent linear system); compare with the open-loop study"
-        )
     if any(getattr(law, "offset", 0.0) != 0.0 for law in setup.elements.laws):
         return None, "describing function: not computed for a gap that is not centred at zero"
+    v = np.asarray(sweep.speeds, dtype=float)
+    if setup.controller is not None:
+        if setup.loop is None:
+            return None, "describing function: not computed for a controller without a loop"
+        from ..design.hinge_describing import loop_describing_branches
+
+        # 32 amplitudes x 40 speeds of a ~100-state loop: about 15 s on one core
+        speeds = np.linspace(0.8 * v.min(), 1.2 * v.max(), 40)
+        try:
+            b = loop_describing_branches(
+                setup.loop, setup.hinges, setup.controller, _loop_amplitudes(setup, sweep), speeds
+            )
+        except (InputError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            return None, f"describing function: not computed ({exc})"
+        return b, "describing function: of the sampled loop, actuator limits inactive"
     model = setup.loop.model if setup.loop is not None else setup.model
     system = model.system(setup.density)
-    gap = setup.gap
     small = system.n_states <= 40  # a section: fine grids; a wing: coarser (eig per speed)
-    n = 120 if small else 36
-    top = max(sweep.amplitudes) * 4.0
-    if gap:  # dense where limit cycles are (A/gap from 0.5 to 2), geometric beyond
-        ratio = np.concatenate(
-            [
-                0.5 + np.geomspace(1e-4, 0.05, n // 6, endpoint=False),
-                np.linspace(0.55, 2.0, 2 * n // 3, endpoint=False),
-                np.geomspace(2.0, max(top / gap, 4.0), n // 6),
-            ]
-        )
-        amps = gap * ratio
-    else:
-        amps = np.geomspace(top * 1e-3, top, n)
-    v = np.asarray(sweep.speeds, dtype=float)
+    amps = _amplitudes(setup, sweep, 120 if small else 36)
     lo, hi = (0.5, 1.5) if small else (0.8, 1.2)
     speeds = np.linspace(lo * v.min(), hi * v.max(), 240 if small else 80)
     try:
         return describing_branches(system, setup.elements, amps, speeds=speeds), None
     except (InputError, ArithmeticError) as exc:
         return None, f"describing function: not computed ({exc})"
+
+
+def _amplitudes(setup: LCOSetup, sweep: LCOSweep, n: int) -> np.ndarray:
+    """``n`` amplitudes [rad]: dense where limit cycles are (A/gap from 0.5 to 2), geometric
+    beyond, up to 4 times the largest initial rotation."""
+    gap = setup.gap
+    top = max(sweep.amplitudes) * 4.0
+    if not gap:
+        return np.geomspace(top * 1e-3, top, n)
+    ratio = np.concatenate(
+        [
+            0.5 + np.geomspace(1e-4, 0.05, n // 6, endpoint=False),
+            np.linspace(0.55, 2.0, 2 * n // 3, endpoint=False),
+            np.geomspace(2.0, max(top / gap, 4.0), n // 6),
+        ]
+    )
+    return gap * ratio
+
+
+def _loop_amplitudes(setup: LCOSetup, sweep: LCOSweep, n: int = 32) -> np.ndarray:
+    """``n`` amplitudes [rad] evenly spaced in the equivalent stiffness of a gap (``N/k`` from
+    1e-3 to its value at 4 times the largest initial rotation, at least 4 gaps): the loop's
+    stability depends on ``N``, and its limit cycles near the gap edge, where ``N`` changes
+    fastest (the buzz of a loop designed for stiff actuators), are resolved."""
+    from ..structure.hinge_laws import freeplay_gain
+
+    gap = setup.gap
+    if not gap:
+        return _amplitudes(setup, sweep, n)
+    top = max(max(sweep.amplitudes) * 4.0 / gap, 4.0)
+    table = 0.5 + np.geomspace(1e-6, top - 0.5, 4000)  # A / gap
+    gain = freeplay_gain(table, 1.0)
+    return gap * np.interp(np.linspace(1e-3, gain[-1], n), gain, table)
