@@ -20,7 +20,7 @@ from ..atomic import atomic_write_set
 from ..errors import InputError
 from ..studies.gust_results import GustLoadsResult
 from .summaries import json_text
-from .user_files import MAX_RESULT_BYTES, read_bytes, user_path
+from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
 
 __all__ = [
     "FORMAT",
@@ -105,9 +105,7 @@ def write_gust_loads(
     """
     from ..studies.gust_scenario import gust_summary
 
-    path = user_path(path, "gust-loads result (.json)")
-    if path.suffix.lower() != ".json":
-        raise InputError(f"path = {str(path)!r}: expected a .json file name")
+    path = json_output(path, "gust-loads result (.json)")
     items = gust_loads_items(result, path, summary or gust_summary(result))
     atomic_write_set(list(items.values()))
     return {k: str(p) for k, (p, _w) in items.items()}
@@ -116,15 +114,7 @@ def write_gust_loads(
 def is_gust_loads_file(path: str | Path) -> bool:
     """Whether ``path`` is a ``.json`` file written by :func:`write_gust_loads` (its first
     kilobytes name the format)."""
-    path = Path(path)
-    if path.suffix.lower() != ".json":
-        return False
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except (OSError, ValueError):
-        return False
-    return f'"format": "{FORMAT}"'.encode() in head
+    return json_of_format(path, FORMAT)
 
 
 def _fail(path: Path, what: str):

@@ -23,7 +23,7 @@ from ..atomic import atomic_write_set
 from ..errors import InputError
 from ..studies.lco_result import TABLE_COLUMNS, LCOResult
 from .summaries import json_text
-from .user_files import MAX_RESULT_BYTES, read_bytes, user_path
+from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
 
 __all__ = ["FORMAT", "lco_items", "write_lco", "load_lco", "is_lco_file", "TABLE_UNITS"]
 
@@ -165,9 +165,7 @@ def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) 
 
     if not isinstance(result, LCOResult):
         raise InputError(f"result = {type(result).__name__}: expected an aeroservo LCOResult")
-    path = user_path(path, "limit-cycle result (.json)")
-    if path.suffix.lower() != ".json":
-        raise InputError(f"path = {str(path)!r}: expected a .json file name")
+    path = json_output(path, "limit-cycle result (.json)")
     items = lco_items(result, path, summary or lco_summary(result))
     atomic_write_set(list(items.values()))
     return {k: str(p) for k, (p, _w) in items.items()}
@@ -176,15 +174,7 @@ def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) 
 def is_lco_file(path: str | Path) -> bool:
     """Whether ``path`` is a ``.json`` file written by :func:`write_lco` (its first
     kilobytes name the format)."""
-    path = Path(path)
-    if path.suffix.lower() != ".json":
-        return False
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except (OSError, ValueError):
-        return False
-    return f'"format": "{FORMAT}"'.encode() in head
+    return json_of_format(path, FORMAT)
 
 
 def _fail(path: Path, what: str):

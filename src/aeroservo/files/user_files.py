@@ -136,3 +136,24 @@ def decode_text(raw: bytes, path: str | Path, what: str = "text file") -> str:
 def read_text(path: str | Path, *, what: str = "text file", limit: int = MAX_TEXT_BYTES) -> str:
     """The text of a user file (see :func:`read_bytes` and :func:`decode_text`)."""
     return decode_text(read_bytes(path, what=what, limit=limit), path, what)
+
+
+def json_output(value: object, what: str) -> Path:
+    """The path of a result to write as JSON: a ``.json`` file name, or an InputError."""
+    path = user_path(value, what)
+    if path.suffix.lower() != ".json":
+        raise InputError(f"path = {str(path)!r}: expected a .json file name")
+    return path
+
+
+def json_of_format(path: str | Path, fmt: str) -> bool:
+    """Whether ``path`` is a ``.json`` file whose first kilobytes name the format ``fmt``."""
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        return False
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except (OSError, ValueError):
+        return False
+    return f'"format": "{fmt}"'.encode() in head
