@@ -7,7 +7,7 @@ the LQR loop of ``scenarios/goland_aileron_lqr.toml`` (1 kHz, actuator limits):
   real time on one core;
 * the same wing in open loop at 136.5 m/s (between the flap-free and gap-closed flutter speeds:
   a limit cycle), recorded at 1 kHz: at least 100 x faster than real time;
-* a 40-speed x 3-amplitude bifurcation diagram of the open loop (130 to 140 m/s, 10 s marches,
+* a 40-speed x 3-amplitude bifurcation diagram of the open loop (130 to 140 m/s, 20 s marches,
   with the up and down sweeps) on 2 Dask workers: under 2 minutes;
 * baseline: the linear march (``simulate``) of the same loop, reported as the ratio of the
   nonlinear march's wall time to it.
@@ -67,8 +67,9 @@ def main() -> None:
 
     n_speeds = 10 if quick else 40
     setup = LCOSetup(model, hinges, sc.density, name="goland-freeplay")
+    bif_duration = 4.0 if quick else 20.0
     sweep = LCOSweep(
-        np.linspace(130.0, 140.0, n_speeds), [0.5 * GAP, GAP, 3 * GAP], duration=duration
+        np.linspace(130.0, 140.0, n_speeds), [0.5 * GAP, GAP, 3 * GAP], duration=bif_duration
     )
     t0 = time.perf_counter()
     diagram = run_lco(setup, sweep, workers=2, describing=False)
@@ -94,7 +95,7 @@ def main() -> None:
     marches = diagram.settings["marches"]
     print(
         f"  bifurcation diagram {n_speeds} speeds x 3 amplitudes + 2 sweeps ({marches} marches "
-        f"of {duration:g} s), 2 workers: {t_bif:6.1f} s  target < 120 s: "
+        f"of {bif_duration:g} s), 2 workers: {t_bif:6.1f} s  target < 120 s: "
         f"{'PASS' if t_bif < 120 else 'FAIL'}"
     )
     lco = diagram.lco_rows()

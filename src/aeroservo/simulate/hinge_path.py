@@ -24,6 +24,7 @@ __all__ = [
     "graze_index",
     "crossing_time",
     "modal_path",
+    "modal_at",
     "rotations_at",
     "state_at",
 ]
@@ -191,6 +192,14 @@ def modal_path(lam, y0, gam, taus) -> np.ndarray:
     return ex * y0[:, None] + _phi1(lam, taus) * gam[:, None]
 
 
+def modal_at(lam, y0, gam, tau: float) -> np.ndarray:
+    """:func:`modal_path` at one time ``tau`` [s] (n,)."""
+    if _far_from_zero(lam):
+        off = gam / lam
+        return np.exp(lam * tau) * (y0 + off) - off
+    return modal_path(lam, y0, gam, np.array([tau]))[:, 0]
+
+
 _SAFE: dict = {}
 
 
@@ -212,7 +221,8 @@ def rotations_at(W, lam, y0, gam, taus) -> np.ndarray:
 
 
 def state_at(V, lam, y0, gam, tau: float) -> np.ndarray:
-    return rotations_at(V, lam, y0, gam, np.array([tau]))[:, 0]
+    """The state ``V y(tau)`` (real) at one time ``tau`` [s]."""
+    return (V @ modal_at(lam, y0, gam, tau)).real
 
 
 def graze_index(s, sd, taus, lo, hi, tol):

@@ -25,6 +25,7 @@ from .hinge_path import (
     crossing_time,
     exits,
     graze_index,
+    modal_at,
     modal_path,
     quick_bracket,
     rotations_at,
@@ -158,7 +159,7 @@ class Regions:
             y0 = Vi @ x
             gam = Gu @ u + gg if Gu.shape[1] else gg
             rest = h - t
-            y1 = modal_path(lam, y0, gam, np.array([rest]))[:, 0]
+            y1 = modal_at(lam, y0, gam, rest)
             v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
             # just after a switch the rotation starts on an edge: scan (a return within the
             # sample would not show at its ends)
