@@ -52,6 +52,8 @@ from ..stability.describing_function import (
     _check_speeds,
     _distance,
     _Point,
+    branches_from_points,
+    check_centred,
 )
 from ..stability.equivalent_system import MAX_ITER, RATIO_TOL, STATIC
 from ..system.hinge_elements import NonlinearHinge
@@ -359,12 +361,7 @@ def loop_describing_branches(
     grid = _check_speeds(speeds)
     tol = check_number("tol", tol, lo=1e-14, hi=1e-3)
     eq = EquivalentLoop(loop, hinges, ctrl, delay, float(grid[0]))
-    for name, law in zip(eq.elements.names, eq.elements.laws, strict=True):
-        if getattr(law, "offset", 0.0) != 0.0:
-            raise InputError(
-                f"hinge '{name}': {law.describe()}: the describing function here is about zero "
-                "rotation; march the nonlinear system instead"
-            )
+    check_centred(eq.elements)
     ones = np.ones(eq.elements.n)
     points: list[list[_Point]] = []
     for a in amps:
@@ -374,25 +371,4 @@ def loop_describing_branches(
             if hit is not None and all(abs(hit[0] - p.speed) > 1e-6 * hit[0] for p in row):
                 row.append(_point(eq, a, *hit, tol))
         points.append(row)
-    flat = [
-        (a, p, b)
-        for a, row, bs in zip(amps, points, _branch_ids(points), strict=True)
-        for p, b in zip(row, bs, strict=True)
-    ]
-    law0, el = eq.elements.laws[0], eq.elements
-
-    def col(name: str, dtype=float) -> np.ndarray:
-        return np.array([getattr(f[1], name) for f in flat], dtype=dtype)
-
-    return DescribingBranches(
-        amplitude=np.array([f[0] for f in flat], dtype=float),
-        speed=col("speed"),
-        frequency=col("frequency"),
-        stable=col("stable", bool),
-        branch=np.array([f[2] for f in flat], dtype=int),
-        ratios=col("ratios").reshape(len(flat), el.n),
-        gap=float(law0.gap) if hasattr(law0, "gap") else None,
-        element=el.names[0],
-        names=tuple(el.names),
-        others_stable=col("others_stable", bool),
-    )
+    return branches_from_points(amps, points, _branch_ids(points), eq.elements)

@@ -222,12 +222,7 @@ def describing_branches(
         raise InputError(f"system = {system!r}: expected an aeroservo FirstOrderSystem")
     if not isinstance(elements, HingeElements):
         raise InputError(f"elements = {elements!r}: expected aeroservo HingeElements")
-    for name, law in zip(elements.names, elements.laws, strict=True):
-        if getattr(law, "offset", 0.0) != 0.0:
-            raise InputError(
-                f"hinge '{name}': {law.describe()}: the describing function here is about zero "
-                "rotation; march the nonlinear system instead"
-            )
+    check_centred(elements)
     amps = _check_amplitudes(amplitudes)
     tol = check_number("tol", tol, lo=1e-14, hi=1e-3)
     eq = EquivalentSystem(system, elements)
@@ -241,29 +236,7 @@ def describing_branches(
             if hit is not None and all(abs(hit[0] - p.speed) > 1e-6 * hit[0] for p in row):
                 row.append(_point(eq, a, *hit, tol))
         points.append(row)
-    ids = _branch_ids(points)
-    flat = [
-        (a, p, b)
-        for a, row, bs in zip(amps, points, ids, strict=True)
-        for p, b in zip(row, bs, strict=True)
-    ]
-    law0 = elements.laws[0]
-
-    def col(name: str, dtype=float) -> np.ndarray:
-        return np.array([getattr(f[1], name) for f in flat], dtype=dtype)
-
-    return DescribingBranches(
-        amplitude=np.array([f[0] for f in flat], dtype=float),
-        speed=col("speed"),
-        frequency=col("frequency"),
-        stable=col("stable", bool),
-        branch=np.array([f[2] for f in flat], dtype=int),
-        ratios=col("ratios").reshape(len(flat), elements.n),
-        gap=float(law0.gap) if hasattr(law0, "gap") else None,
-        element=elements.names[0],
-        names=tuple(elements.names),
-        others_stable=col("others_stable", bool),
-    )
+    return branches_from_points(amps, points, _branch_ids(points), elements)
 
 
 class _Point(NamedTuple):
@@ -351,3 +324,41 @@ def _default_speeds(eq: EquivalentSystem, system: FirstOrderSystem) -> np.ndarra
     if not found:
         return np.linspace(0.01, 1.0, 300) * coarse[-1]
     return np.linspace(0.01, 3.0, 300) * min(c[0] for c in found)
+
+
+def check_centred(elements) -> None:
+    """An InputError for a law whose gap is not centred at zero (the describing function here
+    is about zero rotation)."""
+    for name, law in zip(elements.names, elements.laws, strict=True):
+        if getattr(law, "offset", 0.0) != 0.0:
+            raise InputError(
+                f"hinge '{name}': {law.describe()}: the describing function here is about zero "
+                "rotation; march the nonlinear system instead"
+            )
+
+
+def branches_from_points(amps, points: list, ids: list, elements) -> DescribingBranches:
+    """The :class:`DescribingBranches` of the neutral points found at each amplitude
+    (``points[i]``: the points at ``amps[i]``, ``ids[i]``: their branch ids)."""
+    flat = [
+        (a, p, b)
+        for a, row, bs in zip(amps, points, ids, strict=True)
+        for p, b in zip(row, bs, strict=True)
+    ]
+    law0 = elements.laws[0]
+
+    def col(name: str, dtype=float) -> np.ndarray:
+        return np.array([getattr(f[1], name) for f in flat], dtype=dtype)
+
+    return DescribingBranches(
+        amplitude=np.array([f[0] for f in flat], dtype=float),
+        speed=col("speed"),
+        frequency=col("frequency"),
+        stable=col("stable", bool),
+        branch=np.array([f[2] for f in flat], dtype=int),
+        ratios=col("ratios").reshape(len(flat), elements.n),
+        gap=float(law0.gap) if hasattr(law0, "gap") else None,
+        element=elements.names[0],
+        names=tuple(elements.names),
+        others_stable=col("others_stable", bool),
+    )
