@@ -90,12 +90,13 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
     ax.set_xlabel("airspeed [m/s]")
     ax.set_ylabel(ylabel)
     s = result.settings
-    ax.set_title(
-        f"{s.get('scenario') or s.get('name', '')}: {s.get('reference', '')} "
-        f"({'; '.join(s.get('laws', [])[:1])}), "
-        f"{s.get('controller', '')}",
-        fontsize=10,
+    import textwrap
+
+    title = (
+        f"{s.get('scenario') or s.get('name', '')}\n{s.get('reference', '')}: "
+        f"{'; '.join(s.get('laws', [])[:1])}; {s.get('controller', '')}"
     )
+    ax.set_title("\n".join(textwrap.fill(line, 90) for line in title.split("\n")), fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return ax

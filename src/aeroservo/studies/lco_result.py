@@ -178,11 +178,13 @@ def describing_lines(result) -> list[str]:
         f"{b.frequency[seen].min():.3g}-{b.frequency[seen].max():.3g} Hz"
     ]
     onset = result.onset()
-    if np.isfinite(onset) and b.speed[seen].min() < 0.9 * onset:
+    marched = min(r["speed"] for r in result.rows)
+    early = b.speed[seen & (b.speed >= marched)]  # within the marched speeds only
+    if np.isfinite(onset) and early.size and early.min() < 0.9 * onset:
         lines.append(
             f"  it predicts limit cycles below {onset:.4g} m/s, where no march settles in one "
-            f"(down to {b.speed[seen].min():.4g} m/s): near the gap edges the motion is far "
-            "from the one harmonic it keeps"
+            f"(down to {early.min():.4g} m/s): near the gap edges the motion is far from the "
+            "one harmonic it keeps"
         )
     errs = []
     for r in result.lco_rows():
