@@ -181,7 +181,7 @@ def march_hinges(
         states=X,
         wall_time=wall,
         rotations={name: S[:, j] for j, name in enumerate(el.names)},
-        hinge_moments={name: el.moment(S.T)[j] for j, name in enumerate(el.names)},
+        hinge_moments=dict(zip(el.names, el.moment(S.T), strict=True)),
         switches=np.asarray(switches),
         gaps={name: getattr(law, "gap", None) for name, law in zip(el.names, el.laws, strict=True)},
         method=method,
@@ -219,7 +219,7 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
                 a = np.zeros(Bl.shape[1]) if law.state_feedback else er
                 Dm = np.zeros((Cm.shape[0], m)) if law.state_feedback else Ds
                 entry[0] = M[: sl[4].start]
-                entry += [Cm, Dm, Bl, Cl, Dl, Bl @ a, Dl @ a]
+                entry += [Cm, Dm, Bl, Cl, Dl, Bl @ a, Dl @ a, sl]
             else:
                 entry[0] = np.hstack([Phi, Gu, g[:, None]])
             cache[r] = entry
@@ -229,10 +229,7 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
     r = reg.locate(v[:e])
     ent = region(r)
     if law is not None:
-        M0 = _law_matrix(
-            _sp_dummy(reg.sampled(r), Ds, dt), law, list(range(Cs.shape[0]))
-        )[1]  # fmt: skip
-        ix, i_s, irb, iq, iu, idd, iab, iad = M0
+        ix, i_s, irb, iq, iu, idd, iab, iad = ent[12]  # the row's layout (every region's)
         z = np.zeros(iad.stop)
         z[ix] = x
         mz = ent[5] @ x
@@ -307,10 +304,3 @@ def _march_piecewise(nplant, Bu, Cs, Ds, Dns, dt, x, n_steps, controller, law, m
         X[k + 1] = x1
         v = v1
     return X, U, Cmd, switches
-
-
-def _sp_dummy(sampled, Ds, dt):
-    from ..design.plant import SampledPlant
-
-    Phi, Gu, g, Cr, er = sampled
-    return SampledPlant(Phi, Gu, g[:, None], Cr, Ds, er[:, None], dt, (), (), ())
