@@ -22,7 +22,8 @@ import scipy.linalg as sla
 from .._threads import blas_limited
 from ..aero.indicial import IndicialSet, kussner_set
 from ..errors import RANGES, InputError, check_int, check_number
-from ..system.first_order import check_mach, compressibility_factors, first_order
+from ..system.first_order import check_mach
+from .aero_terms import aero_terms
 from .polynomial import _dense, _Poly
 from .servo import Servo, servos_of
 from .signals import (
@@ -74,7 +75,8 @@ class StateSpaceBuilder:
         complete and consistent with the projected downwash). Default: no truncation.
     mach : float
         Mach number of the Prandtl-Glauert correction (0: incompressible): circulatory and gust
-        loads x 1/beta, lag and Kussner rates x beta^2 (:mod:`aeroservo.system.first_order`).
+        loads x 1/beta, lag and Kussner rates x beta^2 (:mod:`aeroservo.system.first_order`);
+        with the doublet-lattice model, its Mach number.
 
     Notes
     -----
@@ -116,93 +118,50 @@ class StateSpaceBuilder:
         self.outputs = resolve_outputs(model, outputs, n_avail)
         self.servos = servos_of(wing, servo, self.inputs)
 
-        # structural basis: full FE unknowns or a modal truncation
-        am = model.matrices
+        # structural basis: full FE unknowns, a modal truncation, or a doublet-lattice model's
+        # modes; the aerodynamic states and forces of either aerodynamic model
         n_need = max([n_modes or 0] + [o.index + 1 for o in self.outputs if o.kind == "modal"])
         modes = model.natural_modes(n_need) if n_need else None
-        if n_modes is not None:
-            am = am.project(modes.shapes[:, :n_modes])
-            basis = modes.shapes[:, :n_modes]
-        else:
-            basis = None
+        self.mach = mach = _check_mach(model, mach)
+        has_gust = any(d.kind == "gust" for d in self.inputs)
+        terms = aero_terms(model, rho, mach, modes, n_modes, has_gust, gust, self.kussner)
         self.n_modes = n_modes
-        self.basis = basis
+        self.basis = basis = terms.basis
 
         def vec(v: np.ndarray) -> np.ndarray:  # generalized force / row in the used unknowns
             return v if basis is None else basis.T @ v
 
-        self.mach = check_mach(mach)
-        cf, beta2 = compressibility_factors(self.mach)
-        system = first_order(am, model.wagner, rho, model.semichord, mach=self.mach)
+        system = terms.system
         self.system = system
-        n_q = am.n_q
-        T = model.wagner.n_terms
-        n_z = T * am.n_nodes
-        groups = am.circ_groups
-        kus = self.kussner
-        has_gust = any(d.kind == "gust" for d in self.inputs)
-        n_g = len(groups) * kus.n_terms if (gust == "kussner" and has_gust) else 0
+        self.aero_terms = terms
+        n_q = system.n_q
+        n_a = terms.A.shape[1]
         n_s = sum(sv.n_states for sv in self.servos.values())
-        n = 2 * n_q + n_z + n_g + n_s
+        n = n_a + n_s
         m = len(self.inputs)
         iq, iv = slice(0, n_q), slice(n_q, 2 * n_q)
-        iz = slice(2 * n_q, 2 * n_q + n_z)
-        ig = slice(iz.stop, iz.stop + n_g)
         self.n_states = n
+        n0 = system.n_states
 
         A = np.zeros((3, n, n))
         B = np.zeros((2, n, m))
-        n0 = 2 * n_q + n_z
-        for k, a in enumerate((system.A0, system.A1, system.A2)):
-            A[k, :n0, :n0] = _dense(a)
-
-        # aerodynamic generalized forces (without apparent mass) on the free and root unknowns
-        wag = model.wagner
-        scale = cf * (1.0 - sum(wag.A))
-        ab = cf * beta2 * np.asarray(wag.A) * np.asarray(wag.b)
-        rt = am.root
+        A[:, :n_a, :n_a] = terms.A
         Fa = np.zeros((3, n_q, n))
-        Fa[:, :, :n0] = A[:, iv, :n0]
-        Fa[0, :, iq] += _dense(am.Ks)
-        if am.Cs is not None:  # structural damping is not an aerodynamic force
-            Fa[0, :, iv] += _dense(am.Cs)
+        Fa[:, :, :n_a] = terms.Fa
         Fr = np.zeros((3, 3, n))
-        Fr[2, :, iq] = -rho * _dense(rt.Knc - scale * rt.Pq)
-        Fr[1, :, iv] = -rho * _dense(rt.Cnc - scale * rt.Pd)
-        Fr[2, :, iz] = rho * np.kron(_dense(rt.W1), ab[None, :])
+        Fr[:, :, :n_a] = terms.Fr
         Fu = np.zeros((2, n_q, m))
         Fru = np.zeros((2, 3, m))
-
-        # gust
         col = {d.name: j for j, d in enumerate(self.inputs)}
-        g_states = []
         if "gust" in col:
             j = col["gust"]
-            if gust == "kussner":
-                ka, kb = np.asarray(kus.A), np.asarray(kus.b)
-                for gi, g in enumerate(groups):
-                    for t in range(kus.n_terms):
-                        s = ig.start + gi * kus.n_terms + t
-                        A[1, s, s] = -kb[t] * beta2 / g.b
-                        B[0, s, j] = 1.0
-                        Fa[2, :, s] = rho * cf * beta2 * ka[t] * kb[t] * g.Gw
-                        Fr[2, :, s] = rho * cf * beta2 * ka[t] * kb[t] * rt.circ_groups[gi].Gw
-                        g_states.append(f"g{t + 1}_b{gi}")
-                direct = cf * (1.0 - ka.sum())
-            else:
-                B[0, iz, j] = np.kron(np.asarray(am.Mz1.sum(axis=1)).ravel(), np.ones(T))
-                direct = scale
-            Fu[1, :, j] = rho * direct * sum(g.b * g.Gw for g in groups)
-            Fru[1, :, j] = rho * direct * sum(g.b * g.Gw for g in rt.circ_groups)
-
-        A[:, iv, :] = Fa
-        A[0, iv, iq] -= _dense(am.Ks)
-        if am.Cs is not None:
-            A[0, iv, iv] -= _dense(am.Cs)
-        B[:, iv, :] = Fu
+            B[:, :n_a, j] = terms.B_gust
+            Fu[:, :, j] = terms.Fu
+            Fru[:, :, j] = terms.Fru
+        g_states = list(terms.gust_labels)
 
         # control inputs and servo states
-        s_next = ig.stop
+        s_next = n_a
         servo_states: list[str] = []
         self._servo_index: dict[int, int] = {}
         for d in self.inputs:
@@ -248,7 +207,7 @@ class StateSpaceBuilder:
         Cx = np.zeros((3, p, n))
         Du = np.zeros((2, p, m))
         Cacc = np.zeros((p, n_q))
-        mnc = _dense(am.Mnc)
+        mnc = terms.mnc
         for i, o in enumerate(self.outputs):
             if o.kind == "sensor":
                 row = vec(sensor_row(model, o.sensor))
@@ -290,9 +249,9 @@ class StateSpaceBuilder:
             elif o.kind == "root":
                 r = o.index
                 Cx[:, i, :] = Fr[:, r, :]
-                Cx[0, i, iq] -= _dense(rt.Ks)[r]
+                Cx[0, i, iq] -= terms.root_Ks[r]
                 Du[:, i, :] = Fru[:, r, :]
-                Cacc[i] = -_dense(rt.Ms)[r] - rho * _dense(rt.Mnc)[r]
+                Cacc[i] = -terms.root_Ms[r] - rho * terms.root_mnc[r]
         self._C = _Poly(Cx) + acc_x.left(Cacc)
         self._D = _Poly(Du) + acc_u.left(Cacc)
 
@@ -385,6 +344,15 @@ class StateSpaceBuilder:
             for i, v in enumerate(speeds)
         ]
         return [self.at(v, balanced=balanced) for v in vs]
+
+
+def _check_mach(model, mach: object) -> float:
+    """The Mach number of a model: Prandtl-Glauert's for strip theory, the doublet lattice's."""
+    if getattr(model, "dlm", None) is not None:
+        from ..aero.dlm import check_dlm_mach
+
+        return check_dlm_mach(mach)
+    return check_mach(mach)
 
 
 def _block_inverse_dense(system, n0: int) -> np.ndarray:

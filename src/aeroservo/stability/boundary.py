@@ -373,11 +373,10 @@ def _labels(src, modal: ModalSystem, br: Branches) -> list[str]:
     if labeller is None:
         return [f"mode {j + 1}" for j in range(m)]
     x = modal.lift(br.vectors[0])
-    return list(labeller(np.real(x[: modal_n_q(src)])))
-
-
-def modal_n_q(src) -> int:
-    return src.matrices.n_q
+    dlm = getattr(src, "dlm", None)
+    if dlm is not None:  # a doublet-lattice model's unknowns are its basis' modal coordinates
+        return list(labeller(np.real(dlm.basis @ x[: dlm.n_a])))
+    return list(labeller(np.real(x[: src.matrices.n_q])))
 
 
 def _damping_text(src) -> str:

@@ -185,30 +185,17 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
     -------
     list of (frequency [Hz], reason)
     """
-    from ..aero.theodorsen import theodorsen_function
     from .modal import _all_modes
 
     freqs, phi, _labels = _all_modes(model)
     if phi.shape[1] <= n_kept:
         return []
     w0 = 2 * np.pi * freqs[n_kept:]
-    mnc, knc, cnc, groups = _modal_aero(model, n_kept)
-    rho = density
-    cf, beta2 = compressibility_factors(mach)
-    m = 1.0 + rho * mnc
     V = np.linspace(v_max / 16, v_max, 16)[:, None]  # speeds down, modes across
-    w = np.broadcast_to(w0, (V.size, w0.size))
-    for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
-        k = w0**2 + rho * V * V * knc
-        c = rho * V * cnc
-        for b, pq, pd in groups:
-            C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
-            F, G = C.real, C.imag
-            k = k + rho * (-V * V * F * pq + w * V * G * pd)
-            # a frequency driven to zero (flagged below) gives an infinite, harmless term
-            with np.errstate(divide="ignore", invalid="ignore"):
-                c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
-        w = np.sqrt(np.clip(k / m, 0.0, None))
+    if getattr(model, "dlm", None) is not None:
+        w, c = _single_mode_dlm(model, np.arange(n_kept, phi.shape[1]), w0, V, density, mach)
+    else:
+        w, c = _single_mode_strip(model, n_kept, w0, V, density, mach)
     damped_out = c <= 0
     failed = damped_out | (w <= KEEP_FREQUENCY * w0)
     out = []
@@ -222,6 +209,44 @@ def truncated_modes(model, n_kept: int, density: float, v_max: float, mach: floa
         )
         out.append((float(freqs[n_kept + j]), why))
     return out
+
+
+def _single_mode_strip(model, n_kept: int, w0, V, rho: float, mach: float) -> tuple:
+    """Frequencies [rad/s] and aerodynamic damping of each left-out mode alone, strip theory
+    with the exact Theodorsen function (the frequency of the aerodynamics once re-evaluated)."""
+    from ..aero.theodorsen import theodorsen_function
+
+    mnc, knc, cnc, groups = _modal_aero(model, n_kept)
+    cf, beta2 = compressibility_factors(mach)
+    m = 1.0 + rho * mnc
+    w = np.broadcast_to(w0, (V.size, w0.size))
+    for _ in range(2):  # frequency of the aerodynamic terms: once re-evaluated
+        k = w0**2 + rho * V * V * knc
+        c = rho * V * cnc
+        for b, pq, pd in groups:
+            C = theodorsen_function(np.maximum(w * b / (V * beta2), 1e-9)) * cf
+            F, G = C.real, C.imag
+            k = k + rho * (-V * V * F * pq + w * V * G * pd)
+            # a frequency driven to zero (flagged below) gives an infinite, harmless term
+            with np.errstate(divide="ignore", invalid="ignore"):
+                c = c + rho * (-V * F * pd - (V * V * G / w) * pq)
+        w = np.sqrt(np.clip(k / m, 0.0, None))
+    return w, c
+
+
+def _single_mode_dlm(model, cols, w0, V, rho: float, mach: float) -> tuple:
+    """As :func:`_single_mode_strip` with the doublet-lattice forces: ``p^2 + c p + k = 0`` with
+    ``k = w0^2 - q Re Q_jj``, ``c = -q Im Q_jj / w`` at ``k = w b / V``."""
+    q = 0.5 * rho * V * V
+    b = model.dlm.b_ref
+    w = np.broadcast_to(w0, (V.size, w0.size))
+    for _ in range(2):
+        Q = model.dlm.diagonal(mach, np.maximum(w * b / V, 1e-9), cols)
+        k = w0**2 - q * Q.real
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = -q * Q.imag / w
+        w = np.sqrt(np.clip(k, 0.0, None))
+    return w, c
 
 
 def _modal_aero(model, n_kept: int) -> tuple:

@@ -127,6 +127,9 @@ def _all_modes(model) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if "all" not in cache:
         am: AeroMatrices = model.matrices
         w2, phi = sla.eigh(am.Ks.toarray(), am.Ms.toarray())
+        dlm = getattr(model, "dlm", None)
+        if dlm is not None:  # a doublet-lattice model has the modes of its aerodynamic basis
+            w2, phi = w2[: dlm.n_a], dlm.basis
         freqs = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
         labeller = getattr(model, "label_modes", None)
         labels = labeller(phi) if labeller else [f"mode {j + 1}" for j in range(phi.shape[1])]
@@ -172,18 +175,26 @@ class ModalSystem:
         Orthonormal lag-field basis (None: lag fields complete).
     n_terms : int
         Wagner terms ``T``.
+    lag_map : ndarray or None
+        Doublet-lattice models: the full model's lag states of the modal ones (``z = lag_map
+        @ zeta``: the kept modes for each of Roger's lag vectors, the identity for
+        minimum-state).
+    coords : ndarray or None
+        Doublet-lattice models: the kept modes' coordinates in the full (modal) model's basis.
     """
 
     system: FirstOrderSystem
     basis: ModalBasis | None
     lag_basis: np.ndarray | None
     n_terms: int
+    lag_map: np.ndarray | None = None
+    coords: np.ndarray | None = None
 
     def lift(self, x: np.ndarray) -> np.ndarray:
         """Full-model state vectors (columns) of modal-model state vectors."""
         if self.basis is None:
             return x
-        phi = self.basis.shapes
+        phi = self.basis.shapes if self.coords is None else self.coords
         m = phi.shape[1]
         x = np.asarray(x)
         one = x.ndim == 1
@@ -191,7 +202,9 @@ class ModalSystem:
         q = phi @ X[:m]
         v = phi @ X[m : 2 * m]
         z = X[2 * m :]
-        if self.lag_basis is not None:
+        if self.lag_map is not None:
+            z = self.lag_map @ z
+        elif self.lag_basis is not None:
             T = self.n_terms
             r = self.lag_basis.shape[1]
             z = np.einsum("nr,rtk->ntk", self.lag_basis, z.reshape(r, T, -1)).reshape(
@@ -253,8 +266,12 @@ def modal_system(model, density: float, basis: ModalBasis | None, mach: float = 
     The projected matrices are cached on the model per basis, so other densities only rescale.
     """
     wagner = wagner_set(model.wagner)
-    if basis is None or basis.n_modes >= model.matrices.n_q:
+    dlm = getattr(model, "dlm", None)
+    n_full = model.matrices.n_q if dlm is None else dlm.n_a
+    if basis is None or basis.n_modes >= n_full:
         return ModalSystem(model.system(density, mach), None, None, wagner.n_terms)
+    if dlm is not None:
+        return _modal_dlm(model, density, basis, mach)
     cache = model_cache(model)
     key = ("matrices", basis.n_modes)
     if key not in cache:
@@ -268,6 +285,42 @@ def modal_system(model, density: float, basis: ModalBasis | None, mach: float = 
     if skey not in cache:
         cache[skey] = first_order(am, wagner, density, model.semichord, mach=mach)
     return ModalSystem(cache[skey], basis, Q, wagner.n_terms)
+
+
+def _modal_dlm(model, density: float, basis: ModalBasis, mach: float) -> ModalSystem:
+    """The modal model of a doublet-lattice model: its lowest modes (exact for the kept modes:
+    Roger's lag vectors stay in their span)."""
+    from ..system.rfa_system import rfa_first_order
+
+    fit = model.dlm_fit(mach)
+    cache = model_cache(model)
+    key = ("dlm-system", basis.n_modes, float(density), float(fit.mach))
+    if key not in cache:
+        dlm = model.dlm
+        am = model.matrices
+        C = dlm.basis.T @ (am.Ms @ basis.shapes)  # the kept modes in the aerodynamic basis
+        phi = basis.shapes
+        m = phi.shape[1]
+
+        def both(a):
+            return phi.T @ (a.toarray() @ phi)
+
+        system = rfa_first_order(
+            both(am.Ms),
+            both(am.Ks),
+            None if am.Cs is None else both(am.Cs),
+            dlm.modal_fit(fit.mach, C),
+            density,
+            dlm.b_ref,
+            tuple(f"eta_{j + 1}" for j in range(m)),
+            semichord=model.semichord,
+            mach=fit.mach,
+        )
+        kron = np.eye(fit.forces.roots.size)
+        lag_map = kron if fit.forces.kind == "minimum-state" else np.kron(kron, C)
+        cache[key] = (system, C, lag_map)
+    system, C, lag_map = cache[key]
+    return ModalSystem(system, basis, None, 0, lag_map, C)
 
 
 def modal_info(modal: ModalSystem) -> dict:

@@ -172,6 +172,58 @@ def _setup(am: AeroMatrices, rho: float, mach: float = 0.0) -> tuple[_PK, np.nda
     return pk, phi
 
 
+def _reference_semichord(model) -> float:
+    """The model's reference semichord [m] (the mean of its strip groups for a bare section)."""
+    b = getattr(model, "semichord", None)
+    if b is not None:
+        return float(b)
+    return float(np.mean([g.b for g in model.matrices.circ_groups]))
+
+
+class _PKDLM(_PK):
+    """The p-k problem with the doublet-lattice GAFs (interpolated over k) on the modes of a
+    doublet-lattice model's aerodynamic basis: ``K(w) = Ks - q Re Q(ik)``, ``C(w) = Cs - q Im
+    Q(ik) / w`` at ``k = w b / V``."""
+
+    def __init__(self, model, rho: float, mach: float, **kw):
+        super().__init__(Knc=None, Cnc=None, groups=[], rho=rho, **kw)
+        self.model = model
+        self.mach = mach
+        self.coords = np.eye(model.dlm.n_a)
+
+    def frozen(self, V: float, w: float) -> tuple[np.ndarray, np.ndarray]:
+        K = self.Ks
+        C = np.zeros_like(K) if self.Cs is None else self.Cs
+        if V > 0:
+            w_eff = max(w, 1e-9)
+            dlm = self.model.dlm
+            Q = dlm.exact(self.mach, [w_eff * dlm.b_ref / V], self.coords)[0]
+            q = 0.5 * self.rho * V * V
+            K = K - q * Q.real
+            C = C - (q / w_eff) * Q.imag
+        return K, C
+
+
+def _setup_dlm(model, rho: float, mach: float) -> tuple:
+    """The p-k problem of a doublet-lattice model (modal: the basis is its aerodynamic basis),
+    and its exact steady divergence speeds (from ``Q(0)``)."""
+    from ..aero.dlm import check_dlm_mach
+
+    mach = check_dlm_mach(mach)
+    dlm = model.dlm
+    am = model.matrices
+    phi = dlm.basis
+
+    def both(a):
+        return phi.T @ (a.toarray() @ phi)
+
+    Ks = both(am.Ks)
+    pk = _PKDLM(model, rho, mach, M=both(am.Ms), Ks=Ks, Cs=None if am.Cs is None else both(am.Cs))
+    k, Q, _ = dlm.gafs(mach)
+    q0 = Q[int(np.argmin(k)), : dlm.n_a].real
+    return pk, phi, static_speeds(Ks, -0.5 * q0, rho)
+
+
 def static_divergence_speed(am: AeroMatrices, density: float, mach: float = 0.0) -> float | None:
     """Lowest divergence speed [m/s] with the exact steady strip aerodynamics (C = 1, with the
     Prandtl-Glauert factor at ``mach``), or None (robust to round-off:
@@ -229,23 +281,29 @@ def pk_flutter(
         ``eigenvalues`` holds the converged p [1/s]; ``divergence_speed`` is the exact static one.
     """
     rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
-    am: AeroMatrices = model.matrices
+    dlm = getattr(model, "dlm", None)
+    if dlm is None:
+        mach = check_mach(mach)
+        am: AeroMatrices = model.matrices
+        pk, basis = _setup(am, rho, mach)
+        v_divs = static_speeds(am.Ks.toarray(), am.Knc.toarray() - pk.cf * am.Pq.toarray(), rho)
+        n_q = am.n_q
+    else:
+        pk, basis, v_divs = _setup_dlm(model, rho, mach)
+        n_q = dlm.n_a
     if n_modes is None:
         if boundary is None:
             from .boundary import flutter_boundary
 
             boundary = flutter_boundary(model, rho, v_max=v_max, mach=mach)
         n_modes = _followed_modes(model, boundary)
-    n_modes = check_int("n_modes", n_modes, lo=1, hi=am.n_q)
+    n_modes = check_int("n_modes", n_modes, lo=1, hi=n_q)
     n_speeds = check_int("n_speeds", n_speeds, lo=3)
-    mach = check_mach(mach)
-    pk, basis = _setup(am, rho, mach)
     w2, phi = sla.eigh(pk.Ks, pk.M, subset_by_index=[0, n_modes - 1])
     p0 = 1j * np.sqrt(w2)
-    v_divs = static_speeds(am.Ks.toarray(), am.Knc.toarray() - pk.cf * am.Pq.toarray(), rho)
     v_div = float(v_divs[0]) if v_divs.size else None
+    b_ref = _reference_semichord(model)
     if v_max is None:
-        b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
         v_max = default_v_max(b_ref, float(abs(p0[min(1, n_modes - 1)])), v_divs)
     v_max = check_quantity("v_max", v_max, "flight_speed")
     speeds = np.linspace(0.0, v_max, n_speeds)
@@ -285,9 +343,9 @@ def pk_flutter(
         divergence_speed=v_div,
         density=rho,
         v_max=v_max,
-        n_states=2 * am.n_q,
+        n_states=2 * n_q,
         info={
-            "method": "p-k, exact Theodorsen",
+            "method": "p-k, exact Theodorsen" if dlm is None else "p-k, doublet lattice",
             "n_modes": n_modes,
             "branches_ended_at": ended,
             "unconfirmed_sign_changes_at": skipped,
@@ -295,12 +353,11 @@ def pk_flutter(
         },
         warnings=warnings,
         mach=mach,
-        compressibility="prandtl-glauert" if mach > 0 else None,
+        compressibility=("prandtl-glauert" if mach > 0 else None) if dlm is None else "dlm",
         damping=getattr(getattr(model, "damping", None), "describe", lambda: "none")(),
     )
     if boundary is not None:
-        b_ref = float(getattr(model, "semichord", np.mean([g.b for g in am.circ_groups])))
-        wagner = getattr(getattr(model, "wagner", None), "name", "")
+        wagner = getattr(getattr(model, "wagner", None), "name", "") if dlm is None else "RFA"
         note = method_discrepancy(boundary, result, b_ref, wagner)
         if note:
             result.warnings.append(note)

@@ -14,7 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["gauss_rule", "field_shapes", "lag_shapes", "integrate", "point_shapes"]
+__all__ = [
+    "gauss_rule",
+    "field_shapes",
+    "lag_shapes",
+    "integrate",
+    "point_shapes",
+    "pointwise_shapes",
+]
 
 N_GAUSS = 4
 
@@ -125,3 +132,30 @@ def point_shapes(L: float, xi: float) -> tuple[np.ndarray, np.ndarray]:
     """Field values and bending slope at one point: ``N`` (3, 8) and ``S`` (8,)."""
     N, _, S = field_shapes(np.array([L]), np.array([xi]))
     return N[0, 0], S[0, 0]
+
+
+def pointwise_shapes(L: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Field shapes at one local point per entry: element lengths ``L`` and points ``xi``
+    paired (both (n,)), as :func:`field_shapes` gives them for every pair.
+
+    Returns ``N`` (n, 3, 8), ``D`` (n, 3, 8) and ``S`` (n, 8): values of ``[w, phi, delta]``,
+    ``[w'', phi', delta']`` and the bending slope ``w'``.
+    """
+    L = np.atleast_1d(np.asarray(L, dtype=float))
+    xi = np.atleast_1d(np.asarray(xi, dtype=float))
+    n = L.size
+    N = np.zeros((n, 3, 8))
+    D = np.zeros((n, 3, 8))
+    S = np.zeros((n, 8))
+    for i0 in range(0, n, 256):  # the Hermite table is (chunk, chunk): keep it small
+        sl = slice(i0, min(n, i0 + 256))
+        h, dh, d2h = _hermite(xi[sl], L[sl])
+        idx = np.arange(sl.stop - sl.start)
+        h, dh, d2h = h[idx, idx], dh[idx, idx], d2h[idx, idx]
+        x, ll = xi[sl], L[sl]
+        N[sl, 0, 0:4] = h
+        N[sl, 1, 4:6] = N[sl, 2, 6:8] = np.stack([1 - x, x], axis=-1)
+        D[sl, 0, 0:4] = d2h
+        D[sl, 1, 4:6] = D[sl, 2, 6:8] = np.stack([-1 / ll, 1 / ll], axis=-1)
+        S[sl, 0:4] = dh
+    return N, D, S

@@ -7,6 +7,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.linalg as sla
 
+from ..aero.dlm_settings import DoubletLattice, as_aero
 from ..aero.indicial import IndicialSet, wagner_set
 from ..aero.swept_strip import check_sweep_terms
 from ..errors import MAX_ELEMENTS, InputError, check_int, check_number
@@ -15,7 +16,7 @@ from ..structure.wing import Wing
 from .assembly import assemble, element_properties
 from .damping import NO_DAMPING, StructuralDamping, damping_matrix
 from .first_order import FirstOrderSystem, check_mach, first_order
-from .matrices import AeroMatrices
+from .matrices import AeroMatrices, without_strip_aero
 
 __all__ = ["AeroelasticModel", "NaturalModes"]
 
@@ -56,12 +57,17 @@ class AeroelasticModel:
     sweep_terms : {"full", "classical"}
         Spanwise-convection terms of swept segments: all of them (default), or the bending
         slope's alone, as the classical divergence closed form (``docs/sweep.md``).
+    aero : {"strip", "dlm"} or DoubletLattice
+        Aerodynamic model: 2-D strip theory with Wagner lag states (default), or the
+        doublet-lattice method with a rational-function approximation (``"dlm"`` with default
+        settings, or :class:`aeroservo.aero.dlm_settings.DoubletLattice`; ``docs/dlm.md``).
 
     Notes
     -----
     The structural and aerodynamic matrices do not depend on speed or density; they are
     assembled here once. :meth:`system` scales them for a density (cached) and the state matrix
-    at speed V is ``A(V) = A0 + V A1 + V^2 A2``.
+    at speed V is ``A(V) = A0 + V A1 + V^2 A2``. With the doublet-lattice model the Mach number
+    of :meth:`system` is the doublet lattice's (its AICs and fit are made once per Mach number).
     """
 
     def __init__(
@@ -72,6 +78,7 @@ class AeroelasticModel:
         damping: StructuralDamping | None = None,
         *,
         sweep_terms: str = "full",
+        aero: object = "strip",
     ):
         if not isinstance(wing, Wing):
             raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
@@ -86,12 +93,27 @@ class AeroelasticModel:
         self.properties = element_properties(wing, self.mesh)
         self._systems: dict[tuple[float, float], FirstOrderSystem] = {}
         self._parts: dict | None = None  # stiffness parts for label_modes
+        self.aero: DoubletLattice | None = as_aero(aero)
+        self.dlm = None
+        if self.aero is not None:
+            from .dlm_forces import DLMAerodynamics
+
+            self.dlm = DLMAerodynamics(
+                wing, self.mesh, self.aero, self.semichord, self.vacuum_modes()
+            )
+            self.matrices = without_strip_aero(self.matrices)
+
+    @property
+    def aero_model(self) -> str:
+        """``"strip"`` or ``"dlm"``."""
+        return "strip" if self.aero is None else "dlm"
 
     def __repr__(self) -> str:
         damping = "" if not self.damping.active else f", damping={self.damping.describe()!r}"
+        aero = f"wagner={self.wagner.name!r}" if self.aero is None else "aero='dlm'"
         return (
             f"AeroelasticModel({self.wing.name!r}, n_elements={self.n_elements}, "
-            f"wagner={self.wagner.name!r}{damping}, n_states={self.n_states})"
+            f"{aero}{damping}, n_states={self.n_states})"
         )
 
     @property
@@ -101,7 +123,12 @@ class AeroelasticModel:
 
     @property
     def n_states(self) -> int:
-        """States of the first-order system: 2 x structural + lag terms x nodes."""
+        """States of the first-order system: 2 x structural + aerodynamic lag states (Wagner
+        terms x nodes; with the doublet lattice, Roger's lags x unknowns or the minimum-state
+        roots)."""
+        if self.dlm is not None:
+            n = self.dlm.n_a
+            return 2 * n + self.aero.lags * (n if self.aero.rfa == "roger" else 1)
         return 2 * self.n_dofs + self.wagner.n_terms * self.mesh.n_nodes
 
     @property
@@ -113,11 +140,55 @@ class AeroelasticModel:
         """First-order system at air density ``density`` [kg/m^3] and the Mach number ``mach``
         of the compressibility correction (0: incompressible), cached."""
         rho = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
+        if self.aero is not None:
+            return self._dlm_system(rho, mach)
         mach = check_mach(mach)
         key = (rho, mach)
         if key not in self._systems:
             self._systems[key] = first_order(
                 self.matrices, self.wagner, rho, self.semichord, mach=mach
+            )
+        return self._systems[key]
+
+    def dlm_fit(self, mach: float = 0.0):
+        """The doublet-lattice forces' rational approximation at a Mach number
+        (:class:`aeroservo.system.dlm_forces.DLMFit`; its AICs computed once and cached)."""
+        if self.dlm is None:
+            raise InputError("dlm_fit: this model's aerodynamics is strip theory (aero='strip')")
+        return self.dlm.fit(mach)
+
+    def vacuum_modes(self) -> np.ndarray:
+        """Every in-vacuo mode shape, mass-normalized, by increasing frequency (cached)."""
+        if getattr(self, "_vacuum", None) is None:
+            am = self.matrices
+            self._vacuum = sla.eigh(am.Ks.toarray(), am.Ms.toarray())[1]
+        return self._vacuum
+
+    def _dlm_system(self, rho: float, mach: float) -> FirstOrderSystem:
+        """The doublet-lattice model: modal, on the aerodynamic basis (its first unknowns are
+        the modal coordinates ``eta_j`` of the lowest in-vacuo modes)."""
+        from .rfa_system import rfa_first_order
+
+        fit = self.dlm_fit(mach)
+        key = (rho, fit.mach)
+        if key not in self._systems:
+            am = self.matrices
+            phi = self.dlm.basis
+            n = phi.shape[1]
+
+            def both(a):
+                return phi.T @ (a.toarray() @ phi)
+
+            self._systems[key] = rfa_first_order(
+                both(am.Ms),
+                both(am.Ks),
+                None if am.Cs is None else both(am.Cs),
+                self.dlm.modal_fit(fit.mach, np.eye(n)),
+                rho,
+                self.dlm.b_ref,
+                tuple(f"eta_{j + 1}" for j in range(n)),
+                semichord=self.semichord,
+                mach=fit.mach,
             )
         return self._systems[key]
 

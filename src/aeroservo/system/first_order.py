@@ -137,7 +137,13 @@ class FirstOrderSystem:
         """
         n_modes = min(int(n_modes), self.n_q)
         K, M = self.Ks.toarray(), self.M.toarray()
-        w2, phi = sla.eigh(K, M, subset_by_index=[0, n_modes - 1])
+        if _symmetric(M):
+            w2, phi = sla.eigh(K, M, subset_by_index=[0, n_modes - 1])
+        else:  # a fitted apparent mass (doublet lattice): K, M not both symmetric
+            w2, phi = sla.eig(K, M)
+            order = np.argsort(w2.real)[:n_modes]
+            w2, phi = w2.real[order], phi[:, order].real
+            phi = phi / np.linalg.norm(phi, axis=0)
         omega = np.sqrt(np.clip(w2, 0.0, None))
         lam = 1j * omega
         phi = phi.astype(complex)
@@ -174,15 +180,23 @@ def _damped_pair(K, C, M, lam: complex, q: np.ndarray) -> tuple[complex, np.ndar
     return lam, q
 
 
+def _symmetric(a: np.ndarray) -> bool:
+    return bool(np.array_equal(a, a.T))
+
+
 def _block_inverse(E: sp.csr_matrix, n_q: int) -> np.ndarray:
-    """Dense inverse of ``blkdiag(I, M, Mz)`` using Cholesky factors of the SPD blocks."""
+    """Dense inverse of ``blkdiag(I, M, Mz)``: Cholesky factors of the SPD blocks (an LU
+    factorization for a block that is not symmetric: a fitted apparent mass)."""
     n = E.shape[0]
     out = np.zeros((n, n))
     out[:n_q, :n_q] = np.eye(n_q)
     for lo, hi in ((n_q, 2 * n_q), (2 * n_q, n)):
         if hi > lo:
             blk = E[lo:hi, lo:hi].toarray()
-            out[lo:hi, lo:hi] = sla.cho_solve(sla.cho_factor(blk), np.eye(hi - lo))
+            if _symmetric(blk):
+                out[lo:hi, lo:hi] = sla.cho_solve(sla.cho_factor(blk), np.eye(hi - lo))
+            else:
+                out[lo:hi, lo:hi] = sla.lu_solve(sla.lu_factor(blk), np.eye(hi - lo))
     return out
 
 

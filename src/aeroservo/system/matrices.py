@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["AeroMatrices", "StripGroup"]
+__all__ = ["AeroMatrices", "StripGroup", "StripOnly", "without_strip_aero"]
 
 
 @dataclass(frozen=True)
@@ -165,3 +165,41 @@ class AeroMatrices:
             root=root,
             basis=full,
         )
+
+
+class StripOnly:
+    """Stands in for a strip-theory matrix in a model whose aerodynamics is another theory
+    (the doublet-lattice method): any use raises one clear line instead of computing with
+    strip aerodynamics the model does not have."""
+
+    def __init__(self, name: str):
+        self._name = name
+
+    def _fail(self, *args, **kwargs):
+        from ..errors import InputError
+
+        raise InputError(
+            f"strip-theory matrix {self._name!r} used on a model with aero = 'dlm': this "
+            "analysis does not support the doublet-lattice model (use aero = 'strip')"
+        )
+
+    def __getattr__(self, name: str):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        self._fail()
+
+    __add__ = __radd__ = __sub__ = __rsub__ = __mul__ = __rmul__ = _fail
+    __matmul__ = __rmatmul__ = __neg__ = __iter__ = __len__ = __getitem__ = __array__ = _fail
+
+    def __repr__(self) -> str:
+        return f"StripOnly({self._name!r})"
+
+
+def without_strip_aero(am: AeroMatrices) -> AeroMatrices:
+    """``am`` with its strip aerodynamic matrices replaced by :class:`StripOnly` (structure
+    kept): the matrices of a model whose aerodynamics is not strip theory."""
+    names = ("Mnc", "Cnc", "Knc", "circ_groups", "Mz1", "Lz1", "E1", "F1", "W1")
+    root = None
+    if am.root is not None:
+        root = replace(am.root, **{k: StripOnly(k) for k in names})
+    return replace(am, root=root, **{k: StripOnly(k) for k in names})
