@@ -34,11 +34,11 @@ class DoubletLattice:
     Parameters
     ----------
     chordwise : int
-        Boxes along the chord (default 8); a control surface's hinge line is always a box edge,
+        Boxes along the chord (default 6); a control surface's hinge line is always a box edge,
         with at least 2 boxes on the surface.
     spanwise : int, optional
-        Strips along the span; default: boxes about twice as wide as they are long (at least
-        8), placed with edges at every segment boundary and control-surface edge.
+        Strips along the span; default: square boxes (at least 8 strips), with edges at every
+        segment boundary and control-surface edge (``docs/dlm.md``: the convergence study).
     k_max : float
         Highest tabulated reduced frequency ``omega b_ref / V`` [-] (default 2.0): at a speed V
         the approximation is fitted to frequencies up to ``k_max V / (2 pi b_ref)`` Hz.
@@ -62,7 +62,7 @@ class DoubletLattice:
         spanwise strips, at least 12, at most every mode).
     """
 
-    chordwise: int = 8
+    chordwise: int = 6
     spanwise: int | None = None
     k_max: float = 2.0
     reduced_frequencies: tuple | None = None

@@ -22,7 +22,7 @@ from ..aero.indicial import IndicialSet
 from ..system.first_order import FirstOrderSystem, compressibility_factors, first_order
 from .polynomial import _dense
 
-__all__ = ["AeroTerms", "aero_terms", "strip_terms"]
+__all__ = ["AeroTerms", "strip_terms"]
 
 
 @dataclass
@@ -76,39 +76,6 @@ class AeroTerms:
         return self.system.n_q
 
 
-def aero_terms(
-    model,
-    rho: float,
-    mach: float,
-    modes,
-    n_modes: int | None,
-    has_gust: bool,
-    gust: str,
-    kussner: IndicialSet,
-) -> AeroTerms:
-    """The aerodynamic terms of ``model`` (strip theory or doublet lattice).
-
-    Parameters
-    ----------
-    model : AeroelasticModel
-    rho, mach : float
-        Density [kg/m^3]; Mach number (Prandtl-Glauert for strip theory, the doublet lattice's).
-    modes : NaturalModes or None
-        In-vacuo modes (their shapes give a strip model's modal truncation).
-    n_modes : int or None
-        Modal truncation (None: every unknown of the model).
-    has_gust : bool
-        Whether the gust is an input.
-    gust : {"kussner", "upwash"}
-    kussner : IndicialSet
-    """
-    if getattr(model, "dlm", None) is not None:
-        from .dlm_terms import dlm_terms
-
-        return dlm_terms(model, rho, mach, n_modes, has_gust, gust)
-    return strip_terms(model, rho, mach, modes, n_modes, has_gust, gust, kussner)
-
-
 def strip_terms(
     model,
     rho: float,
@@ -119,8 +86,23 @@ def strip_terms(
     gust: str,
     kussner: IndicialSet,
 ) -> AeroTerms:
-    """Strip theory's terms (:func:`aero_terms`): Wagner lag states per node, Kussner gust states
-    per distinct semichord (or the upwash gust through the lag states)."""
+    """Strip theory's terms: Wagner lag states per node, Kussner gust states per distinct
+    semichord (or the upwash gust through the lag states).
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    rho, mach : float
+        Density [kg/m^3]; Mach number (Prandtl-Glauert).
+    modes : NaturalModes or None
+        In-vacuo modes (their shapes give the modal truncation).
+    n_modes : int or None
+        Modal truncation (None: every unknown of the model).
+    has_gust : bool
+        Whether the gust is an input.
+    gust : {"kussner", "upwash"}
+    kussner : IndicialSet
+    """
     am = model.matrices
     basis = None
     if n_modes is not None:

@@ -23,7 +23,8 @@ from .._threads import blas_limited
 from ..aero.indicial import IndicialSet, kussner_set
 from ..errors import RANGES, InputError, check_int, check_number
 from ..system.first_order import check_mach
-from .aero_terms import aero_terms
+from .aero_terms import strip_terms
+from .dlm_terms import dlm_terms
 from .polynomial import _dense, _Poly
 from .servo import Servo, servos_of
 from .signals import (
@@ -124,7 +125,10 @@ class StateSpaceBuilder:
         modes = model.natural_modes(n_need) if n_need else None
         self.mach = mach = _check_mach(model, mach)
         has_gust = any(d.kind == "gust" for d in self.inputs)
-        terms = aero_terms(model, rho, mach, modes, n_modes, has_gust, gust, self.kussner)
+        if model.dlm is not None:
+            terms = dlm_terms(model, rho, mach, n_modes, has_gust, gust)
+        else:
+            terms = strip_terms(model, rho, mach, modes, n_modes, has_gust, gust, self.kussner)
         self.n_modes = n_modes
         self.basis = basis = terms.basis
 

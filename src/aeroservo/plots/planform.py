@@ -48,10 +48,19 @@ def planform_points(wing, station: float, offset) -> np.ndarray:
     return base + np.multiply.outer(np.atleast_1d(offset), aft)
 
 
-def plot_planform(wing, *, title: str | None = None) -> Figure:
+def plot_planform(wing, *, title: str | None = None, lattice=None) -> Figure:
     """Top view of a wing: outline, elastic axis, control surfaces (shaded aft of their hinge
     lines), actuators (crosses on the hinge line) and concentrated masses (circles at their
-    CG, area proportional to the mass, labelled), equal axes in metres."""
+    CG, area proportional to the mass, labelled), equal axes in metres.
+
+    Parameters
+    ----------
+    wing : Wing
+    title : str, optional
+    lattice : Lattice, optional
+        Doublet-lattice boxes to draw on it (``model.dlm.grid.lattice``): their outlines and
+        load points (the 1/4-chord points of the boxes).
+    """
     ends = [
         planform_points(wing, s.end, [-s.semichord * (1 + s.a), s.semichord * (1 - s.a)])
         for s in wing.segments
@@ -123,6 +132,8 @@ def plot_planform(wing, *, title: str | None = None) -> Figure:
                 fontsize=8,
             )
         ax.scatter([], [], s=60, color="C3", ec="k", label="concentrated mass (CG)")
+    if lattice is not None:
+        _draw_lattice(ax, lattice)
     ax.set_aspect("equal")
     ax.invert_yaxis()  # the free stream comes from the top of the page
     ax.set_xlabel("spanwise position Y [m]")
@@ -137,3 +148,17 @@ def plot_planform(wing, *, title: str | None = None) -> Figure:
         fontsize=9,
     )
     return fig
+
+
+def _draw_lattice(ax, lattice) -> None:
+    """Box outlines (planform coordinates: x spanwise, y aft) and load points."""
+    from matplotlib.collections import PolyCollection
+
+    boxes = PolyCollection(
+        lattice.corners, facecolors="none", edgecolors="C0", linewidths=0.5, alpha=0.8
+    )
+    ax.add_collection(boxes)
+    pts = lattice.load_points
+    ax.plot(pts[:, 0], pts[:, 1], ".", color="C0", ms=2)
+    where = "mirrored at the root" if lattice.symmetric else "no root symmetry plane"
+    ax.plot([], [], "s", mfc="none", mec="C0", label=f"{lattice.n_boxes} DLM boxes ({where})")

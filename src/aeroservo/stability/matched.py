@@ -19,6 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..aero.atmosphere import Atmosphere
+from ..aero.dlm import DLM_MACH_WARN
 from ..errors import InputError
 from ..system.first_order import (
     MACH_APPROXIMATE,
@@ -32,21 +33,25 @@ from .result import Crossing, FlutterResult
 
 __all__ = ["flutter_at", "COMPRESSIBILITY", "MACH_TOL"]
 
-COMPRESSIBILITY = ("none", "prandtl-glauert")
+COMPRESSIBILITY = ("none", "prandtl-glauert", "matched")
 MACH_TOL = 1e-6
 """Matched-point tolerance on ``|M - V / a|``."""
 
 _TOP = MACH_LIMIT * (1 - 1e-9)
+DLM_TOP = 0.99
+"""Highest Mach number of a doublet-lattice matched point."""
 
 
-def _check(compressibility: str | None) -> str | None:
+def _check(compressibility: str | None, model=None) -> str | None:
+    """The compressibility of a model: None, ``"prandtl-glauert"`` (strip theory, also given as
+    ``"matched"``) or ``"dlm"`` (a doublet-lattice model matched to its Mach number)."""
     if compressibility in (None, "none"):
         return None
-    if compressibility != "prandtl-glauert":
+    if compressibility not in COMPRESSIBILITY:
         raise InputError(
             f"compressibility = {compressibility!r}: allowed values are {list(COMPRESSIBILITY)}"
         )
-    return compressibility
+    return "dlm" if getattr(model, "dlm", None) is not None else "prandtl-glauert"
 
 
 def flutter_at(
@@ -90,8 +95,9 @@ def flutter_at(
         raise InputError(
             f"atmosphere = {atmosphere!r}: expected aeroservo.aero.atmosphere.isa(...)"
         )
-    comp = _check(compressibility)
+    comp = _check(compressibility, model)
     rho, a = atmosphere.density, atmosphere.speed_of_sound
+    top_mach = _TOP if comp != "dlm" else DLM_TOP
     if comp is None:
         r = _flight(solver(model, rho, **kw), atmosphere, None, [])
         for what, v in (("flutter", r.flutter_speed), ("divergence", r.divergence_speed)):
@@ -108,7 +114,7 @@ def flutter_at(
         history.append({"mach": mach, "flutter_speed": res.flutter_speed})
         return res
 
-    m = float(np.clip(mach_start, 0.0, _TOP))
+    m = float(np.clip(mach_start, 0.0, top_mach))
     r = run(m)
     ms, fs = [m], [_residual(r, a, m)]
 
@@ -120,7 +126,7 @@ def flutter_at(
             m_new = m + f  # fixed point: M <- V_f / a
         else:
             m_new = m - f * (ms[-1] - ms[-2]) / (fs[-1] - fs[-2])
-        m_new = float(np.clip(m_new, 0.0, _TOP))
+        m_new = float(np.clip(m_new, 0.0, top_mach))
         if m_new == m:
             break
         m = m_new
@@ -128,12 +134,14 @@ def flutter_at(
         ms.append(m)
         fs.append(_residual(r, a, m))
     matched = abs(fs[-1]) < MACH_TOL
+    limit = MACH_LIMIT if comp != "dlm" else 1.0
+    theory = "Prandtl-Glauert correction" if comp != "dlm" else "subsonic doublet lattice"
     if not matched:
-        top = min(r.searched_up_to, MACH_LIMIT * a)
-        if r.flutter_speed is None or r.flutter_speed / a >= MACH_LIMIT * (1 - 1e-6):
+        top = min(r.searched_up_to, limit * a)
+        if r.flutter_speed is None or r.flutter_speed / a >= top_mach * (1 - 1e-6):
             warnings.append(
-                f"no matched flutter point below Mach {MACH_LIMIT:g} (the limit of the "
-                f"Prandtl-Glauert correction): no flutter below {top:.5g} m/s TAS"
+                f"no matched flutter point below Mach {limit:g} (the limit of the {theory}): "
+                f"no flutter below {top:.5g} m/s TAS"
             )
             r = _without_flutter(r, top)
         else:
@@ -141,18 +149,23 @@ def flutter_at(
                 f"the Mach iteration did not converge in {len(ms)} boundaries "
                 f"(|M - V/a| = {abs(fs[-1]):.2g})"
             )
-    v_div = _matched_divergence(model, rho, a)
+    if comp == "dlm":
+        v_div, diverges = _matched_dlm_divergence(model, rho, a)
+    else:
+        v_div = _matched_divergence(model, rho, a)
+        diverges = divergence_speeds(model.system(rho)).size > 0
     r = _with_divergence(r, v_div)
-    if v_div is None and divergence_speeds(model.system(rho)).size:
+    if v_div is None and diverges:
         warnings.append(
-            f"no matched divergence below Mach {MACH_LIMIT:g} (the limit of the Prandtl-Glauert "
-            f"correction, {MACH_LIMIT * a:.5g} m/s TAS)"
+            f"no matched divergence below Mach {limit:g} (the limit of the {theory}, "
+            f"{limit * a:.5g} m/s TAS)"
         )
+    approximate = MACH_APPROXIMATE if comp != "dlm" else DLM_MACH_WARN
     for what, v in (("flutter", r.flutter_speed), ("divergence", v_div)):
-        if v is not None and v / a > MACH_APPROXIMATE:
+        if v is not None and v / a > approximate:
             warnings.append(
-                f"{what} at Mach {v / a:.3f}: the Prandtl-Glauert correction is approximate above "
-                f"Mach {MACH_APPROXIMATE:g}"
+                f"{what} at Mach {v / a:.3f}: the {theory} is approximate above "
+                f"Mach {approximate:g}"
             )
 
     out = _flight(r, atmosphere, comp, history)
@@ -207,6 +220,29 @@ def _matched_divergence(model, rho: float, a: float) -> float | None:
         return None  # no divergence below Mach 0.9
     m = brentq(g, 0.0, _TOP, xtol=1e-12, rtol=1e-12)
     return v_d(m)
+
+
+def _matched_dlm_divergence(model, rho: float, a: float) -> tuple[float | None, bool]:
+    """The divergence speed of a doublet-lattice model whose Mach number V / a is the one of its
+    steady vortex-lattice forces (root finding on the Mach number), and whether it diverges at
+    Mach 0."""
+    dlm = model.dlm
+    ks = dlm.basis.T @ (model.matrices.Ks.toarray() @ dlm.basis)
+
+    def v_d(m: float) -> float:
+        v = static_speeds(ks, -0.5 * dlm.steady(m), rho)
+        return float(v[0]) if v.size else np.inf
+
+    def g(m: float) -> float:
+        return min(v_d(m) / a, 10.0) - m
+
+    v0 = v_d(0.0)
+    if g(0.0) <= 0:
+        return v0, True
+    if g(DLM_TOP) > 0:
+        return None, np.isfinite(v0)
+    m = brentq(g, 0.0, DLM_TOP, xtol=1e-10, rtol=1e-12)
+    return v_d(m), True
 
 
 def _with_divergence(r: FlutterResult, v_div: float | None) -> FlutterResult:

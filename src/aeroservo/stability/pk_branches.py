@@ -2,7 +2,7 @@
 the p-k at a given onset.
 
 Each branch is continued from the previous speed by the p-k iteration
-(:meth:`aeroservo.stability.pk._PK.converge`). Branches whose roots lie within
+(:meth:`aeroservo.stability.pk_frozen._PK.converge`). Branches whose roots lie within
 :data:`aeroservo.stability.branches.CLUSTER` of each other (the flap modes of a control surface
 without torsional stiffness: one per mesh node) are continued as one cluster, as in the
 time-domain search: the frozen problem at the cluster's frequency is solved completely, its

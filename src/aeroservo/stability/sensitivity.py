@@ -39,36 +39,18 @@ from dataclasses import dataclass, field
 from ..errors import InputError
 from ..system.aeroelastic import AeroelasticModel
 from ..system.damping import damping_parameters
-from ..system.derivatives import PARAMETERS
+from .parameters import TIE, TOUCH, _tie, parameter_values, with_parameters
 from .result import FlutterResult
 from .sensitivity_terms import Terms
 
-__all__ = ["FlutterSensitivities", "flutter_sensitivities", "parameter_values", "TIE", "TOUCH"]
-
-TIE = 1e-3
-"""Two onsets closer than this relative speed: a mode switch, not differentiable."""
-
-TOUCH = 1e-5
-"""``Re(dlambda/dV) V / |lambda|`` below this: the branch only touches the axis."""
-
-
-def parameter_values(wing) -> dict[str, tuple[str, tuple[int, ...], str, float]]:
-    """Every wing parameter offered, by its wing-file name, with ``(owner, index, key, value)``."""
-    out: dict = {}
-    for i, seg in enumerate(wing.segments):
-        for key in PARAMETERS["segment"]:
-            out[f"segments[{i}].{key}"] = ("segment", (i,), key, float(getattr(seg, key)))
-    for k, cs in enumerate(wing.control_surfaces):
-        for key in PARAMETERS["surface"]:
-            out[f"control_surfaces[{k}].{key}"] = ("surface", (k,), key, float(getattr(cs, key)))
-        for j, act in enumerate(cs.actuators):
-            for key in PARAMETERS["actuator"]:
-                name = f"control_surfaces[{k}].actuators[{j}].{key}"
-                out[name] = ("actuator", (k, j), key, float(getattr(act, key)))
-    for i, pm in enumerate(wing.masses):
-        for key in PARAMETERS["mass"]:
-            out[f"masses[{i}].{key}"] = ("mass", (i,), key, float(getattr(pm, key)))
-    return out
+__all__ = [
+    "FlutterSensitivities",
+    "flutter_sensitivities",
+    "parameter_values",
+    "with_parameters",
+    "TIE",
+    "TOUCH",
+]
 
 
 @dataclass
@@ -94,6 +76,9 @@ class FlutterSensitivities:
     altitude, mach : float or None
         Geopotential altitude [m] of an atmosphere-based analysis, Mach number of the
         aerodynamics (0: incompressible); ``matched``: the Mach number follows the speed.
+    method : str
+        ``"analytic"`` (eigenvalue derivatives) or ``"finite differences"`` (a
+        doublet-lattice model: central differences of whole boundaries).
     """
 
     flutter_speed: float | None
@@ -109,6 +94,7 @@ class FlutterSensitivities:
     altitude: float | None = None
     mach: float = 0.0
     matched: bool = False
+    method: str = "analytic"
 
     def normalized(self) -> dict[str, float]:
         """``p / V_f dV_f/dp`` per parameter [-]: the % change of V_f per % of p."""
@@ -125,6 +111,7 @@ class FlutterSensitivities:
             "altitude": self.altitude,
             "mach": self.mach,
             "matched_mach": self.matched,
+            "method": self.method,
             "non_differentiable": self.non_differentiable,
             "undefined": dict(self.undefined),
             "values": dict(self.values),
@@ -150,7 +137,8 @@ def flutter_sensitivities(
     rtol: float = 1e-10,
     **kw,
 ) -> FlutterSensitivities:
-    """Analytic sensitivities of the flutter and divergence speeds (see the module notes).
+    """Analytic sensitivities of the flutter and divergence speeds (see the module notes); of a
+    doublet-lattice model, central finite differences (:mod:`.sensitivity_fd`).
 
     Parameters
     ----------
@@ -206,6 +194,11 @@ def flutter_sensitivities(
         mach=r.mach,
         matched=matched,
     )
+    if model.dlm is not None:
+        from .sensitivity_fd import finite_differences
+
+        finite_differences(model, r, out, table, atmosphere, compressibility, kw)
+        return out
     terms = Terms(model, r, matched)
     for name in names:
         why = terms.add(name, table.get(name))
@@ -256,17 +249,3 @@ def _checked(parameters: object, known: dict) -> list[str]:
                 f"{[*list(known)[:6], '...', *[k for k in known if '[' not in k]]}"
             )
     return list(parameters)
-
-
-def _tie(r: FlutterResult) -> str | None:
-    """A reason the flutter speed is not differentiable, or None."""
-    vf = r.flutter_speed
-    onsets = [c for c in r.crossings if c.kind == "onset"]
-    near = [c for c in onsets if c.mode != r.flutter.mode and abs(c.speed - vf) <= TIE * vf]
-    if near:
-        c = near[0]
-        return (
-            f"mode switch: branches {r.flutter.mode} and {c.mode} go unstable at {vf:.6g} and "
-            f"{c.speed:.6g} m/s (within {TIE:g}); V_f is the smaller of two smooth functions"
-        )
-    return None

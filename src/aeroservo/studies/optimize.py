@@ -12,13 +12,13 @@ the flutter speed (two boundaries per variable and iterate) for comparison.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError, check_int, check_number
 from ..stability.boundary import flutter_boundary
-from ..stability.sensitivity import flutter_sensitivities, parameter_values
+from ..stability.sensitivity import flutter_sensitivities, parameter_values, with_parameters
 from ..system.aeroelastic import AeroelasticModel
 
 __all__ = ["Optimization", "optimize_wing", "with_parameters", "design_variables"]
@@ -59,28 +59,6 @@ class Optimization:
             "n_boundaries": self.n_boundaries,
             "iterations": list(self.iterations),
         }
-
-
-def with_parameters(wing, values: dict):
-    """The wing with parameters (wing-file names) set to ``values``."""
-    table = parameter_values(wing)
-    segs, surfaces, masses = list(wing.segments), list(wing.control_surfaces), list(wing.masses)
-    for name, v in values.items():
-        owner, idx, key, _ = table[name]
-        if owner == "mass":
-            masses[idx[0]] = replace(masses[idx[0]], **{key: v})
-        elif owner == "segment":
-            segs[idx[0]] = replace(segs[idx[0]], **{key: v})
-        elif owner == "surface":
-            surfaces[idx[0]] = replace(surfaces[idx[0]], **{key: v})
-        else:
-            cs = surfaces[idx[0]]
-            acts = list(cs.actuators)
-            acts[idx[1]] = replace(acts[idx[1]], **{key: v})
-            surfaces[idx[0]] = replace(cs, actuators=tuple(acts))
-    return replace(
-        wing, segments=tuple(segs), control_surfaces=tuple(surfaces), masses=tuple(masses)
-    )
 
 
 def optimize_wing(

@@ -172,6 +172,17 @@ class DLMAerodynamics:
             self._gafs[mach] = (k, Q, Qg)
         return self._gafs[mach]
 
+    def steady(self, mach: float) -> np.ndarray:
+        """Steady modal forces ``Q(0)`` on the aerodynamic basis at a Mach number (vortex
+        lattice only; cached with the AICs), (n_a, n_a) per unit dynamic pressure."""
+        mach = check_dlm_mach(mach)
+        if mach in self._gafs:
+            k, Q, _ = self._gafs[mach]
+            return Q[int(np.argmin(k)), : self.n_a].real
+        Qjj = aics(self.grid.lattice, mach, np.zeros(1), kernel=self.settings.kernel)[0]
+        RA = self.rows[:, : self.n_a].T * self.area[None, :]
+        return -(RA @ Qjj @ self.Zy_j).real
+
     def fit(self, mach: float) -> DLMFit:
         """The rational approximation at a Mach number (cached)."""
         mach = check_dlm_mach(mach)

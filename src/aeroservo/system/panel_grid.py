@@ -31,8 +31,8 @@ __all__ = ["PanelGrid", "panel_grid", "axis_frames"]
 MIN_STRIPS = 8
 """Fewest spanwise strips of the default box division."""
 
-BOX_ASPECT = 2.0
-"""Default box width over box chord (Nastran's guidance allows up to about 3 for the DLM)."""
+BOX_ASPECT = 1.0
+"""Default box width over box chord: square boxes (the measured convergence of docs/dlm.md)."""
 
 MERGE = 1e-3
 """Strip edges closer than this fraction of the span are merged."""
