@@ -42,6 +42,7 @@ bench: install
 	$(BIN)/python bench/bench_trade.py
 	$(BIN)/python bench/bench_gust_loads.py
 	$(BIN)/python bench/bench_lco.py
+	$(BIN)/python bench/bench_dlm.py
 
 # a few minutes: the issue-17 targets with fewer repeats (CI runs it as a smoke test that
 # reports and does not gate on timing: tests/test_bench.py)
@@ -50,6 +51,7 @@ bench-quick: install
 	$(BIN)/python bench/bench_flutter.py --quick
 	$(BIN)/python bench/bench_mpc_step.py --quick
 	$(BIN)/python bench/bench_trade.py --quick
+	$(BIN)/python bench/bench_dlm.py --quick
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .ruff_cache

@@ -7,7 +7,11 @@ and confidence codes). Each test names the case id it uses.
 
 from __future__ import annotations
 
+import atexit
 import json
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -16,6 +20,22 @@ import aeroservo as aes
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).parent.parent
+
+# The doublet-lattice AICs are cached on disk (aeroservo.aero.dlm): the tests share one fresh
+# folder (inherited by the command-line runs they start), removed at the end, so that they
+# neither read nor fill the user's cache.
+_AIC_CACHE = tempfile.mkdtemp(prefix="aeroservo-test-aics-")
+os.environ["AEROSERVO_CACHE"] = _AIC_CACHE
+atexit.register(shutil.rmtree, _AIC_CACHE, ignore_errors=True)
+
+
+def needs_panelaero():
+    """Skip with the reason when the optional doublet-lattice library is missing."""
+    return pytest.importorskip(
+        "panelaero",
+        reason="PanelAero is not installed (pip install 'aeroservo[dlm]'): doublet-lattice "
+        "tests skip",
+    )
 
 
 def reference(case_id: str) -> dict:
@@ -45,6 +65,20 @@ def goland10_flutter(goland10) -> aes.FlutterResult:
 @pytest.fixture(scope="session")
 def aileron10() -> aes.AeroelasticModel:
     return aes.AeroelasticModel(aes.examples.goland_aileron(), n_elements=10)
+
+
+@pytest.fixture(scope="session")
+def goland_dlm() -> aes.AeroelasticModel:
+    """Goland's wing with the doublet lattice at its default settings (10 elements)."""
+    needs_panelaero()
+    return aes.AeroelasticModel(aes.examples.goland(), n_elements=10, aero="dlm")
+
+
+@pytest.fixture(scope="session")
+def aileron_dlm() -> aes.AeroelasticModel:
+    """Goland's wing with its aileron and the doublet lattice (10 elements)."""
+    needs_panelaero()
+    return aes.AeroelasticModel(aes.examples.goland_aileron(), n_elements=10, aero="dlm")
 
 
 @pytest.fixture(autouse=True)

@@ -22,6 +22,7 @@ BENCH = Path(__file__).resolve().parents[1] / "bench"
         ("bench_trade.py", 1),
         ("bench_gust_loads.py", 4),
         ("bench_lco.py", 3),
+        ("bench_dlm.py", 3),
     ],
 )
 def test_quick_benchmark_reports_its_targets(script, targets):

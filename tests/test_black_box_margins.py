@@ -512,7 +512,9 @@ def equivalent(kind):
         return loop, spec, vf, speed, ctrl, user
     ctrl = ctrl.at(speed)  # the scheduled LQG at its design speed 1.1 V_f: a fixed design
     comp, Bu, K, M = python_control_lqg(loop, spec, speed)
-    assert np.abs(K - ctrl.K).max() <= 1e-12 * np.abs(ctrl.K).max()
+    # two Riccati solutions (python-control's and the package's): measured 4e-11 of the largest
+    # gain with numpy 2.4 / scipy 1.17 (2e-13 before); the bound is the solutions' conditioning
+    assert np.abs(K - ctrl.K).max() <= 1e-9 * np.abs(ctrl.K).max()
     assert np.abs(M - ctrl.kf.M).max() <= 1e-10 * np.abs(ctrl.kf.M).max()
     # brought with its estimator's prediction input (what it does when a limit cuts the command)
     user = compensator_from_lti(comp, sample_rate=1e3, anti_windup=Bu, source="python-control")

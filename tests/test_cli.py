@@ -133,12 +133,23 @@ FLUTTER_MODULES = {
     "aeroservo.errors",
     *(
         f"aeroservo.aero{m}"
-        for m in ("", ".atmosphere", ".indicial", ".swept_strip", ".theodorsen")
+        for m in (
+            "",
+            ".atmosphere",
+            ".dlm",  # numpy only: the doublet-lattice settings and their checks
+            ".dlm_settings",
+            ".indicial",
+            ".lattice",
+            ".rfa",
+            ".swept_strip",
+            ".theodorsen",
+        )
     ),
     *(
         f"aeroservo.cli{m}"
         for m in (
             "",
+            ".aero_options",
             ".analysis",
             ".envelope",
             ".importing",
@@ -173,6 +184,8 @@ FLUTTER_MODULES = {
             ".tracking",
         )
     ),
+    "aeroservo.studies",
+    "aeroservo.studies.flight_condition",
     *(
         f"aeroservo.structure{m}"
         for m in ("", ".beam_element", ".examples", ".masses", ".mesh", ".wing")

@@ -411,13 +411,13 @@ from rest with a unit rotation rate (``x0 = c_rate / |c_rate|^2``) at 120 m/s: f
 steps of 1 us of the free system."""
 
 
-@pytest.mark.parametrize("excess", [1e-6, 1e-2])
+@pytest.mark.parametrize("excess", [1e-5, 1e-2])
 def test_a_graze_within_a_sample_is_found(goland, excess):
     """The gap set so that actuator1 just passes its edge, by ``excess`` x gap/2, near 1.05 ms
-    and comes back: the reference crosses out, in, and out again (1.0528, 1.0562, 1.5177 ms
-    for 1e-6; 0.9161, 1.2759, 1.4300 ms for 1e-2). The march at 1 ms finds the first crossing
+    and comes back: the reference crosses out, in, and out again (near 1.05 ms
+    for 1e-5 (1e-6 was used until numpy 2.4 / scipy 1.17 moved the peak by more than that); 0.9161, 1.2759, 1.4300 ms for 1e-2). The march at 1 ms finds the first crossing
     only and keeps the spring engaged while the rotation is back in the gap (state error 1.5e-4
-    and 1e-5 of the peak): for 1e-6 the return follows the switch within the sample (the test
+    and 1e-5 of the peak): for 1e-5 the return follows the switch within the sample (the test
     from the interval's ends, ``quick_bracket``, is trusted right after a switch); for 1e-2 the return
     and the exit fall in the next sample, whose ends-only Hermite test (``leaves``) misses
     them."""

@@ -179,7 +179,16 @@ def test_near_critical_on_the_vg_plot_and_in_the_saved_sweep(tmp_path, capsys):
     code, _out, _err = cli(capsys, "flutter", str(TWO_FLAPS), "--save", str(tmp_path / "s.npz"))
     assert code == 0
     back = load_result(tmp_path / "s.npz").result
-    assert back.near_critical == r.near_critical
+    # the command line's analysis is a second computation: the speed of a damping minimum is
+    # determined only to about the square root of the damping's rounding (a flat minimum), so
+    # the two agree to 1e-5 in speed, the damping itself to 1e-9 (measured: 1.7e-6, 1e-12)
+    assert len(back.near_critical) == len(r.near_critical)
+    for b, a in zip(back.near_critical, r.near_critical, strict=True):
+        assert (b.mode, b.threshold) == (a.mode, a.threshold)
+        assert b.speed == pytest.approx(a.speed, rel=1e-5)
+        assert b.frequency == pytest.approx(a.frequency, rel=1e-5)
+        assert b.damping_ratio == pytest.approx(a.damping_ratio, rel=1e-7)
+        assert b.speed_range == pytest.approx(a.speed_range, rel=1e-5)
 
 
 @pytest.mark.parametrize(("v_max", "found"), [(77.5, True), (76.0, True), (75.5, False)])

@@ -76,7 +76,7 @@ def test_good_file(tmp_path):
         ("end = 4.0\nhinge", "end = 5.0\nhinge", "outside the wing"),
         ("station = 3.0", "station = 1.0", r"actuators\[0\].station = 1"),
         ("density = 1.0", "density = 0.0", "analysis.density = 0"),
-        ("density = 1.0", "density = 1.0\nmach = 0.5", "analysis.mach: unknown key"),
+        ("density = 1.0", "density = 1.0\nmachs = 0.5", "analysis.machs: unknown key"),
         ("wagner = { A = [0.5], b = [0.2] }", 'wagner = "fancy"', "unknown set"),
         ("span = 4.0", "span = [4.0]", r"wing.span = \[4.0\]: expected a real number"),
         (

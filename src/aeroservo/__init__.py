@@ -20,6 +20,7 @@ _PUBLIC = {
     "nonlinear_plant": "linear.hinge_plant",
     "run_lco": "studies.lco_run",
     "AeroelasticModel": "system.aeroelastic",
+    "DoubletLattice": "aero.dlm_settings",
     "ConcentratedMass": "structure.masses",
     "Actuator": "structure.wing",
     "ControlSurface": "structure.wing",

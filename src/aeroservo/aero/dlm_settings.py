@@ -40,8 +40,10 @@ class DoubletLattice:
         Strips along the span; default: square boxes (at least 8 strips), with edges at every
         segment boundary and control-surface edge (``docs/dlm.md``: the convergence study).
     k_max : float
-        Highest tabulated reduced frequency ``omega b_ref / V`` [-] (default 2.0): at a speed V
-        the approximation is fitted to frequencies up to ``k_max V / (2 pi b_ref)`` Hz.
+        Highest tabulated reduced frequency ``omega b_ref / V`` [-] (default 1.0, twice the
+        flutter reduced frequencies of beam-like wings, 0.1-0.6; ``docs/dlm.md`` has the
+        measured trade between range and fit error): at a speed V the approximation is fitted
+        to frequencies up to ``k_max V / (2 pi b_ref)`` Hz.
     reduced_frequencies : sequence of float, optional
         The tabulated k (instead of :data:`K_SPACING` x ``k_max``); 0 is added.
     rfa : {"roger", "minimum-state"}
@@ -64,7 +66,7 @@ class DoubletLattice:
 
     chordwise: int = 6
     spanwise: int | None = None
-    k_max: float = 2.0
+    k_max: float = 1.0
     reduced_frequencies: tuple | None = None
     rfa: str = "roger"
     lags: int = 4

@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from .aero_options import add_aero_options, resolve_aero
 from .envelope import add_parser as add_envelope_parser
 from .envelope import cmd_envelope
 from .options import (
@@ -93,8 +94,10 @@ def add_parsers(sub) -> None:
     m.add_argument(
         "--planform",
         metavar="FILE",
-        help="top view of the wing: sweep, control surfaces, actuators, masses (png, pdf, svg)",
+        help="top view of the wing: sweep, control surfaces, actuators, masses, and the "
+        "doublet-lattice boxes with --aero dlm or a file's aero = 'dlm' (png, pdf, svg)",
     )
+    add_aero_options(m)
 
 
 def _wing_text(spec: str, wing) -> str:
@@ -116,19 +119,16 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     check_suffix("--save", args.save, ".npz")
     check_suffix("--table", args.table, ".csv")
     s = setup(args)
-    from ..stability.boundary import flutter_boundary
+    from ..studies.flight_condition import aero_record, flutter_at_condition, mach_source
 
     model, wing = s.model, s.wing
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
     n_modes = args.modes if args.modes is not None else s.opts.n_modes
     kw = {"v_max": v_max, "n_modes": n_modes}
+    cond = (model, s.density, s.atmosphere, s.compressibility, s.mach)
     with named("n_modes", "--modes" if args.modes is not None else None, args, "n_modes"):
-        if s.atmosphere is not None:
-            from ..stability.matched import flutter_at
-
-            result = flutter_at(model, s.atmosphere, compressibility=s.compressibility, **kw)
-        else:
-            result = flutter_boundary(model, s.density, **kw)
+        result = flutter_at_condition(*cond, **kw)
+    source = mach_source(s.compressibility, s.mach, s.atmosphere)
     out = {
         "wing": wing.name,
         "flutter_speed": result.flutter_speed,
@@ -139,6 +139,7 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         "n_elements": model.n_elements,
         "wagner": model.wagner.name,
         "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3", "altitude": "m"},
+        **aero_record(model, result.mach, source),
     }
     out.update({k: v for k, v in result.to_dict().items() if k not in out})
     pk = None
@@ -146,20 +147,15 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         from ..stability.pk import pk_flutter
 
         kw["v_max"] = result.v_max
-        if s.atmosphere is not None:
-            from ..stability.matched import flutter_at
-
-            pk = flutter_at(
-                model, s.atmosphere, compressibility=s.compressibility, solver=pk_flutter, **kw
-            )
-        else:
-            pk = pk_flutter(model, s.density, boundary=result, **kw)
+        if s.atmosphere is None:
+            kw["boundary"] = result
+        pk = flutter_at_condition(*cond, solver=pk_flutter, **kw)
         from ..stability.near_critical import method_discrepancy
 
         note = method_discrepancy(result, pk, model.semichord, model.wagner.name)
         if note and note not in pk.warnings:  # the matched (altitude) path
             pk.warnings.append(note)
-        out["pk_exact_theodorsen"] = {
+        out["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
             "flutter_eas": pk.flutter_eas,
@@ -169,7 +165,8 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
             "restarted_at_onsets": pk.info.get("restarted_at_onsets", []),
             "warnings": list(pk.warnings),
         }
-    title = f"{wing.name}: {model.n_elements} elements, {model.wagner.name}"
+    aero = model.wagner.name if model.dlm is None else f"doublet lattice, Mach {result.mach:.3g}"
+    title = f"{wing.name}: {model.n_elements} elements, {aero}"
     writers = []
     if args.plot:
         from ..atomic import figure_writer
@@ -201,14 +198,21 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(out, indent=2))
         return 0
-    print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
+    if model.dlm is None:
+        print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
+    else:
+        from ..studies.flight_condition import aero_text
+
+        print(f"{wing.name}: {model.n_elements} elements")
+        print(aero_text(model, result.mach, source))
     print(result.summary(warnings=False, units=args.units))
     if pk is not None:
+        how = "exact Theodorsen" if model.dlm is None else "doublet lattice"
         if pk.flutter_speed is None:
-            print(f"p-k (exact Theodorsen): no flutter below {pk.searched_up_to:.4g} m/s")
+            print(f"p-k ({how}): no flutter below {pk.searched_up_to:.4g} m/s")
         else:
             text = pk.speed_text(pk.flutter_speed, args.units)
-            print(f"p-k (exact Theodorsen): flutter {text} at {pk.flutter_frequency:.5g} Hz")
+            print(f"p-k ({how}): flutter {text} at {pk.flutter_frequency:.5g} Hz")
     for key, what in (("plot", "plot"), ("saved", "sweep"), ("table", "table")):
         if key in out:
             print(f"{what} written to {out[key]}")
@@ -224,8 +228,11 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     check_suffix("--animate", args.animate, ".gif")
     check_figure(args.planform, "--planform")
     wing, opts = resolve_wing(args.wing)
+    aero, _mach, _comp = resolve_aero(args, opts)
     with named("n_elements", "--elements" if args.elements else None, args, "elements"):
-        model = AeroelasticModel(wing, n_elements=args.elements or opts.elements)
+        model = AeroelasticModel(
+            wing, n_elements=args.elements or opts.elements, aero=aero or "strip"
+        )
     check_int("-n", args.n, lo=1, hi=model.n_dofs)
     modes = model.natural_modes(min(max(args.n, args.mode or 1), model.n_dofs))
     if args.mode is not None and args.mode > modes.frequencies.size:
@@ -278,7 +285,8 @@ def _mode_figures(args: argparse.Namespace, model, modes) -> None:
     if args.planform:
         from ..plots.planform import plot_planform
 
-        fig = plot_planform(model.wing)
+        lattice = None if model.dlm is None else model.dlm.grid.lattice
+        fig = plot_planform(model.wing, lattice=lattice)
         writers.append((args.planform, figure_writer(fig, args.planform, dpi=130)))
     if args.animate:
         j = (args.mode or 1) - 1

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .aero_options import COMPRESSIBILITY_CHOICES, add_mach_option
 from .options import add_model_options, check_figure, check_suffix, positive_float, setup
 
 __all__ = ["add_parser", "cmd_envelope"]
@@ -33,9 +34,11 @@ def add_parser(sub) -> None:
     )
     e.add_argument(
         "--compressibility",
-        choices=("none", "prandtl-glauert"),
-        help="Prandtl-Glauert correction, Mach matched at each altitude",
+        choices=COMPRESSIBILITY_CHOICES,
+        help="Mach number matched to the speed at each altitude (strip theory's Prandtl-Glauert "
+        "correction, the doublet lattice's Mach number)",
     )
+    add_mach_option(e)
     e.add_argument("--units", choices=("si", "knots"), default="si")
     add_model_options(e)
     e.add_argument("--json", action="store_true", help="print one JSON object")
@@ -81,6 +84,7 @@ def cmd_envelope(args: argparse.Namespace) -> int:
             md=args.md,
             margin=args.margin,
             progress=(lambda i: bar.update(1)) if bar is not None else None,
+            **({} if s.mach is None else {"mach": s.mach}),
         )
     finally:
         if bar is not None:
@@ -101,14 +105,22 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     if args.json:
         print(json_text(env.to_dict()))
         return 0
-    print(_envelope_text(env, args.units))
+    print(_envelope_text(env, args.units, _aero_label(s)))
     for kind, path in (("table", args.csv), ("plot", args.plot), ("envelope", args.save)):
         if path:
             print(f"{kind} written to {path}")
     return 0
 
 
-def _envelope_text(env, units: str) -> str:
+def _aero_label(s) -> str | None:
+    """The aerodynamics of the envelope when it is not strip theory's default (None)."""
+    if s.model.dlm is not None:
+        mach = "Mach matched" if s.compressibility else f"Mach {s.mach or 0.0:g}"
+        return f"doublet lattice, {mach}"
+    return None if s.mach is None else f"Prandtl-Glauert at Mach {s.mach:g}"
+
+
+def _envelope_text(env, units: str, aero: str | None = None) -> str:
     from ..aero.atmosphere import KNOT
 
     k = 1 / KNOT if units == "knots" else 1.0
@@ -117,7 +129,7 @@ def _envelope_text(env, units: str) -> str:
     def f(v, fmt="8.4g"):
         return f"{'-':>8s}" if v is None else f"{v:{fmt}}"
 
-    comp = env.compressibility or "incompressible"
+    comp = aero or env.compressibility or "incompressible"
     lines = [f"{env.wing}: flutter envelope ({comp}; structural damping {env.damping})"]
     head = f"  {'alt [m]':>8s} {'VF TAS':>8s} {'VF EAS':>8s} {'MF':>8s} {'Vdiv EAS':>8s}"
     if env.envelope:

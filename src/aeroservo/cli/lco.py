@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import InputError
+from .aero_options import add_aero_options, load_scenario_with
 from .loads import _workers
 
 __all__ = ["add_parsers", "HANDLERS", "run_lco_loaded", "plot_saved", "LCO_KINDS"]
@@ -40,6 +41,7 @@ def add_parsers(sub) -> None:
         "describing function)",
     )
     r.add_argument("--no-plots", action="store_true", help="write the data files only")
+    add_aero_options(r, mach=True)
     r.add_argument(
         "--quiet",
         dest="progress",
@@ -60,10 +62,9 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_lco(args: argparse.Namespace) -> int:
-    from ..files.scenario_file import load_scenario
     from .options import require_kind
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario_with(args.scenario, args)
     require_kind(scenario, args.scenario, "lco")
     return run_lco_loaded(scenario, args)
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from .aero_options import add_aero_options, load_scenario_with
+
 __all__ = ["add_parsers", "HANDLERS", "run_loaded"]
 
 
@@ -38,6 +40,7 @@ def add_parsers(sub) -> None:
         help="fast settings for smoke tests (the first two flight points, at most 5 gradients)",
     )
     r.add_argument("--no-plots", action="store_true", help="write the data files only")
+    add_aero_options(r, mach=True)
     r.add_argument(
         "--progress",
         action=argparse.BooleanOptionalAction,
@@ -56,10 +59,9 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_loads(args: argparse.Namespace) -> int:
-    from ..files.scenario_file import load_scenario
     from .options import require_kind
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario_with(args.scenario, args)
     require_kind(scenario, args.scenario, "gust_loads")
     return run_loaded(scenario, args)
 

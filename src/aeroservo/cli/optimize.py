@@ -91,17 +91,22 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         damping=op.damping,
         v_max=op.v_max,
         gradients=args.gradients,
+        aero="strip" if op.aero is None else op.aero,
+        mach=op.mach,
     )
+    # the doublet lattice's sensitivities are finite differences (stability.sensitivity_fd)
+    how = args.gradients if op.aero is None else f"{args.gradients} (finite differences, dlm)"
     files = _write(op, r, out, args.file) if out is not None else {}
     if args.json:
         from ..files.summaries import json_text
 
         extra = {"files": files} if files else {}
-        print(json_text({"name": op.name, "gradients": args.gradients, **r.to_dict(), **extra}))
+        aero = {"aero": "strip" if op.aero is None else "dlm", "mach": op.mach or 0.0}
+        print(json_text({"name": op.name, "gradients": how, **aero, **r.to_dict(), **extra}))
         return 0 if r.success else 1
     print(
         f"{op.name}: {r.message} ({len(r.iterations)} designs analysed, "
-        f"{r.n_boundaries} flutter boundaries, {args.gradients} gradients)"
+        f"{r.n_boundaries} flutter boundaries, {how} gradients)"
     )
     for n, v in r.variables.items():
         print(f"  {n:44s} {r.start[n]:12.6g} -> {v:12.6g}")

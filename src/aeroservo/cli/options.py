@@ -7,6 +7,13 @@ import contextlib
 from dataclasses import dataclass
 
 from ..errors import InputError, parse_number
+from .aero_options import (
+    COMPRESSIBILITY_CHOICES,
+    add_aero_options,
+    add_mach_option,
+    finite_number,
+    resolve_aero,
+)
 
 __all__ = [
     "quantity",
@@ -69,16 +76,6 @@ def elements(text: str) -> int:
     return v
 
 
-def _number(text: str) -> float:
-    try:
-        v = parse_number(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if v != v or abs(v) == float("inf"):
-        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number")
-    return v
-
-
 def _numbers(text: str) -> list[float]:
     try:
         return [parse_number(t) for t in text.split(",")]  # a blank item is a ValueError
@@ -89,11 +86,13 @@ def _numbers(text: str) -> list[float]:
 
 
 def add_model_options(p: argparse.ArgumentParser) -> None:
-    """``--elements``, ``--wagner`` and the structural damping options."""
+    """``--elements``, ``--wagner``, ``--aero``, ``--boxes`` and the structural damping
+    options."""
     p.add_argument(
         "--elements", type=elements, help="number of beam elements (default: file, else 10)"
     )
     p.add_argument("--wagner", help="Wagner set: rt_jones, wp_jones, one_term, fit2, fit3, fit4")
+    add_aero_options(p)
     d = p.add_mutually_exclusive_group()
     d.add_argument(
         "--damping-ratio",
@@ -104,7 +103,7 @@ def add_model_options(p: argparse.ArgumentParser) -> None:
     )
     d.add_argument(
         "--structural-g",
-        type=_number,
+        type=finite_number,
         metavar="G",
         help="structural damping g (equivalent viscous zeta = g/2 at every in-vacuo mode)",
     )
@@ -125,14 +124,19 @@ def add_flight_options(p: argparse.ArgumentParser) -> None:
         help="air density [kg/m^3] (default: file, else 1.225)",
     )
     f.add_argument(
-        "--altitude", type=_number, metavar="M", help="geopotential altitude [m] (ISA 1976)"
+        "--altitude", type=finite_number, metavar="M", help="geopotential altitude [m] (ISA 1976)"
     )
-    f.add_argument("--altitude-ft", type=_number, metavar="FT", help="altitude [ft] (ISA 1976)")
+    f.add_argument(
+        "--altitude-ft", type=finite_number, metavar="FT", help="altitude [ft] (ISA 1976)"
+    )
     p.add_argument(
         "--compressibility",
-        choices=("none", "prandtl-glauert"),
-        help="Prandtl-Glauert correction, Mach matched at the altitude (needs an altitude)",
+        choices=COMPRESSIBILITY_CHOICES,
+        help="Mach number matched to the speed at the altitude (needs an altitude): strip "
+        "theory's Prandtl-Glauert correction, the doublet lattice's Mach number ('matched' and "
+        "'prandtl-glauert' say the same)",
     )
+    add_mach_option(p)
     p.add_argument(
         "--units", choices=("si", "knots"), default="si", help="speeds in the text and plots"
     )
@@ -148,6 +152,7 @@ class Setup:
     density: float
     compressibility: str | None
     opts: object
+    mach: float | None = None  # a fixed Mach number (None: 0, or matched with compressibility)
 
 
 def _damping(args, default):
@@ -232,6 +237,8 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
             altitude=sc.altitude,
             compressibility=sc.compressibility,
             damping=sc.damping,
+            aero=sc.aero,
+            mach=sc.mach,
         )
     else:
         wing, opts = resolve_wing(args.wing)
@@ -244,8 +251,7 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
         atm = isa(opts.altitude)
     density = atm.density if atm is not None else (getattr(args, "density", None) or opts.density)
 
-    comp = getattr(args, "compressibility", None) or opts.compressibility
-    comp = None if comp == "none" else comp
+    aero, mach, comp = resolve_aero(args, opts, "model" if scenario else "analysis")
     if comp is not None and atm is None and not altitudes:
         raise InputError(
             f"--compressibility = {comp!r}: needs the speed of sound, give --altitude M or "
@@ -255,8 +261,10 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
     wagner = args.wagner if args.wagner is not None else opts.wagner
     option = "--elements" if args.elements is not None else None
     with named("n_elements", option, args, "elements"):
-        model = AeroelasticModel(wing, elements, wagner, damping=_damping(args, opts.damping))
-    return Setup(wing, model, atm, density, comp, opts)
+        model = AeroelasticModel(
+            wing, elements, wagner, damping=_damping(args, opts.damping), aero=aero or "strip"
+        )
+    return Setup(wing, model, atm, density, comp, opts, mach)
 
 
 def check_figure(path: str | None, option: str = "--plot") -> None:

@@ -346,8 +346,11 @@ def _cmd_export(args: argparse.Namespace) -> int:
         n_modes = check_int("--design-modes", args.design_modes, lo=1, hi=s.model.n_dofs)
     from ..files.wing_model import correction_mach
 
-    # Prandtl-Glauert (when asked for) at the export's own Mach number
-    mach = correction_mach(args.speed, s.atmosphere, s.compressibility, "--speed / speed of sound")
+    # a fixed Mach number, or (when asked for) the export's own Mach number V / a
+    mach = s.mach
+    if mach is None:
+        field = "--speed / speed of sound"
+        mach = correction_mach(args.speed, s.atmosphere, s.compressibility, field, s.model)
     sys = statespace(
         s.model,
         args.speed,
@@ -362,7 +365,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
     print(
         f"{s.wing.name} at {args.speed:g} m/s, {s.density:.5g} kg/m^3: {sys.nstates} states, "
         f"inputs {list(sys.input_labels)}, outputs {list(sys.output_labels)}"
-        + (f", Prandtl-Glauert at Mach {mach:.4g}" if mach else "")
+        + (f", Prandtl-Glauert at Mach {mach:.4g}" if mach and s.model.dlm is None else "")
+        + (f", doublet lattice at Mach {mach:.4g}" if s.model.dlm is not None else "")
         + f" -> {args.out}"
     )
     return 0

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from ..errors import InputError
+from .aero_options import add_aero_options, load_scenario_with
 from .options import positive_int, run_into_folder
 
 __all__ = ["add_parsers", "HANDLERS"]
@@ -34,6 +35,7 @@ def add_parsers(sub) -> None:
             default=None,
             help="progress bars on stderr (default: when stderr is a terminal)",
         )
+        add_aero_options(r, mach=True)
         if name in ("run", "trade"):
             r.add_argument(
                 "--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://host:port"
@@ -65,7 +67,7 @@ def _cmd_examples(args: argparse.Namespace) -> int:
                 data = read_toml(path)
             except InputError:
                 continue
-            top = {"wing", "analysis", "damping", "hinges"}
+            top = {"wing", "analysis", "damping", "hinges", "dlm"}
             if set(data) <= top and isinstance(data.get("wing"), dict):
                 wings.append((path.name, str(data["wing"].get("name", ""))))
         if wings:
@@ -77,11 +79,10 @@ def _cmd_examples(args: argparse.Namespace) -> int:
 
 def _cmd_run(args: argparse.Namespace) -> int:
 
-    from ..files.scenario_file import load_scenario
     from ..files.summaries import json_text
     from ..studies.scenario import quick
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario_with(args.scenario, args)
     if args.command != "run":
         from .options import require_kind
 
@@ -209,9 +210,11 @@ def _readable(s: dict) -> str:
             )
         lines.append(f"  divergence {f(s['divergence_speed'], ' m/s')}")
         lines += [f"  warning: {w}" for w in s.get("warnings", [])]
-        if "pk_exact_theodorsen" in s:
-            pk = s["pk_exact_theodorsen"]
-            lines.append(f"  p-k, exact C(k): flutter {f(pk['flutter_speed'], ' m/s')}")
+        if s.get("aero") == "dlm":
+            lines.append(f"  doublet lattice at Mach {s['mach']:.4g} ({s['mach_source']})")
+        for key, how in (("pk_exact_theodorsen", "exact C(k)"), ("pk_doublet_lattice", "DLM")):
+            if key in s:
+                lines.append(f"  p-k, {how}: flutter {f(s[key]['flutter_speed'], ' m/s')}")
     elif s["kind"] == "simulate":
         lines.append(
             f"  {s['controller']} at {s['speed']:.5g} m/s "

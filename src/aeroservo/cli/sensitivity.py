@@ -43,7 +43,9 @@ def _cmd_sensitivity(args: argparse.Namespace) -> int:
 
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
     kw = {"v_max": v_max, "n_modes": s.opts.n_modes}
-    if s.atmosphere is not None:
+    if s.mach is not None:  # a fixed Mach number: at the density (of the altitude)
+        kw.update(density=s.density, mach=s.mach)
+    elif s.atmosphere is not None:
         kw.update(atmosphere=s.atmosphere, compressibility=s.compressibility)
     else:
         kw["density"] = s.density
@@ -57,15 +59,15 @@ def _cmd_sensitivity(args: argparse.Namespace) -> int:
     if args.json:
         from ..files.summaries import json_text
 
-        print(json_text({"wing": s.wing.name, **sens.to_dict()}))
+        print(json_text({"wing": s.wing.name, "aero": s.model.aero_model, **sens.to_dict()}))
         return 0
-    print(_text(s.wing.name, sens))
+    print(_text(s.wing.name, sens, s.model))
     if sens.non_differentiable:
         print(f"aeroservo: warning: {sens.non_differentiable}", file=sys.stderr)
     return 0
 
 
-def _text(name: str, sens) -> str:
+def _text(name: str, sens, model=None) -> str:
     def f(v):
         return "-" if v is None else f"{v:.6g}"
 
@@ -74,6 +76,8 @@ def _text(name: str, sens) -> str:
         where = f"{sens.altitude:.6g} m ({where})"
     if sens.mach:
         where += f", Mach {sens.mach:.4g}" + (" (matched)" if sens.matched else "")
+    if model is not None and model.dlm is not None:
+        where += f", doublet lattice; derivatives by {sens.method}"
     lines = [
         f"{name} at {where}: flutter {f(sens.flutter_speed)} m/s, "
         f"{f(sens.flutter_frequency)} Hz; divergence {f(sens.divergence_speed)} m/s",

@@ -241,17 +241,41 @@ def state_map(plant_builder, design_builder, *, balanced: bool = True) -> np.nda
     if design_builder.n_modes is None:
         return np.eye(n_p)  # the same builder kind: the same scaling
     r = design_builder.n_modes
-    phi = design_builder.basis
-    proj = phi.T @ plant_builder.model.matrices.Ms.toarray()
-    T = np.zeros((n_d, n_p))
-    T[:r, :n_q] = proj
-    T[r : 2 * r, n_q : 2 * n_q] = proj
-    rest = n_p - 2 * n_q
-    if rest != n_d - 2 * r:
-        raise InputError("state_map: the non-structural states of the two models differ")
-    T[2 * r :, 2 * n_q :] = np.eye(rest)
+    if getattr(plant_builder.model, "dlm", None) is not None:
+        T = _dlm_state_map(plant_builder.model, r, n_p, n_d)
+    else:
+        phi = design_builder.basis
+        proj = phi.T @ plant_builder.model.matrices.Ms.toarray()
+        T = np.zeros((n_d, n_p))
+        T[:r, :n_q] = proj
+        T[r : 2 * r, n_q : 2 * n_q] = proj
+        rest = n_p - 2 * n_q
+        if rest != n_d - 2 * r:
+            raise InputError("state_map: the non-structural states of the two models differ")
+        T[2 * r :, 2 * n_q :] = np.eye(rest)
     if balanced:
         T = T * (1.0 / design_builder.state_scaling)[:, None] * plant_builder.state_scaling[None, :]
+    return T
+
+
+def _dlm_state_map(model, r: int, n_p: int, n_d: int) -> np.ndarray:
+    """:func:`state_map` of a doublet-lattice model: both are written on its aerodynamic basis
+    (modal coordinates ``eta``), the design model on its first ``r`` modes. Roger's lag states
+    (root-major, one per mode) of the kept modes are kept; minimum-state lag states, gust and
+    servo states are shared (as strip theory's nodal lag states are)."""
+    n_a = model.dlm.n_a
+    lags = model.aero.lags
+    roger = model.aero.rfa == "roger"
+    n_lp, n_ld = (lags * n_a, lags * r) if roger else (lags, lags)
+    rest = n_p - 2 * n_a - n_lp
+    if rest != n_d - 2 * r - n_ld:
+        raise InputError("state_map: the non-structural states of the two models differ")
+    T = np.zeros((n_d, n_p))
+    T[:r, :r] = np.eye(r)
+    T[r : 2 * r, n_a : n_a + r] = np.eye(r)
+    kept = [j * n_a + i for j in range(lags) for i in range(r)] if roger else list(range(lags))
+    T[2 * r + np.arange(n_ld), 2 * n_a + np.asarray(kept)] = 1.0
+    T[n_d - rest :, n_p - rest :] = np.eye(rest)
     return T
 
 

@@ -169,7 +169,8 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
     spec = s.controller if s.controller is not None and s.controller.type != "none" else None
     for case, wing in g["mass_cases"].items():
         where = "" if case == NOMINAL else f" (mass case {case!r})"
-        model = AeroelasticModel(wing, s.elements, s.wagner, damping=s.damping)
+        aero = "strip" if s.aero is None else s.aero
+        model = AeroelasticModel(wing, s.elements, s.wagner, damping=s.damping, aero=aero)
         for i, name in enumerate(g["loads"]):
             try:
                 resolve_outputs(model, [name], model.n_dofs)

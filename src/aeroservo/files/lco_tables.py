@@ -87,7 +87,7 @@ def section_table(top: Table, kw: dict) -> None:
     st = top.table("section")
     md = top.table("model")
     for key in md.data:
-        if key != "wagner":
+        if key != "wagner" and (key, md.data[key]) != ("aero", "strip"):
             md.fail(key, md.data[key], "not used with a [section] (only model.wagner)")
     for name in ("signals", "controller", "simulation"):
         if top.has(name):

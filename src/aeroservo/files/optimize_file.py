@@ -22,12 +22,16 @@ flutter_speed_min = 150.0
 
 [damping]                # optional: structural damping, as in a wing file (g, ratio, alpha/beta)
 g = 0.02
+
+[dlm]                    # optional, with [optimize] aero = "dlm" (and mach = 0.3, a fixed Mach
+chordwise = 6            # number): the doublet lattice's settings, as in a wing file
 ```
 
 ``aeroservo optimize FILE --out DIR`` writes the optimum as a set (:func:`optimum_writers`):
-``<stem>_wing.toml`` (a wing file with the file's density, elements, ``v_max`` and damping in
-``[analysis]`` and ``[damping]``: ``aeroservo flutter`` on it repeats the optimum's fresh
-analysis), ``<stem>_history.csv`` (one row per SLSQP iterate) and ``<stem>_convergence.png``.
+``<stem>_wing.toml`` (a wing file with the file's density, elements, ``v_max``, ``aero``,
+``mach`` and damping in ``[analysis]``, ``[dlm]`` and ``[damping]``: ``aeroservo flutter`` on it
+repeats the optimum's fresh analysis), ``<stem>_history.csv`` (one row per SLSQP iterate) and
+``<stem>_convergence.png``.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import MAX_ELEMENTS, InputError
+from .aero_tables import aero_options, dlm_toml
 from .toml_tables import Table, check_integers, one_line_errors, read_toml
 from .wing_file import damping_from_dict, wing_from_dict
 
@@ -89,6 +94,8 @@ class OptimizationFile:
     objective: object
     constraints: dict
     damping: object = None
+    aero: object = None  # DoubletLattice or None (strip theory)
+    mach: float | None = None
 
 
 def _bounds(top: Table) -> dict:
@@ -112,9 +119,15 @@ def load_optimization(path: str | Path) -> OptimizationFile:
     with one_line_errors():
         check_integers(data, file)
         top = Table(data, "", file).check_keys(
-            ("optimize", "wing", "variables", "objective", "constraints"), ("damping",)
+            ("optimize", "wing", "variables", "objective", "constraints"), ("damping", "dlm")
         )
-        op = top.table("optimize").check_keys(("density",), ("name", "elements", "v_max"))
+        op = top.table("optimize").check_keys(
+            ("density",), ("name", "elements", "v_max", "aero", "mach")
+        )
+        try:
+            aero, mach = aero_options(op.data, "optimize", data.get("dlm"), "dlm")
+        except InputError as exc:
+            raise InputError(f"{file}: {exc}") from None
         try:
             wing = wing_from_dict(data["wing"])
         except InputError as exc:
@@ -148,6 +161,8 @@ def load_optimization(path: str | Path) -> OptimizationFile:
             objective=objective,
             constraints=constraints,
             damping=damping,
+            aero=aero,
+            mach=mach,
         )
 
 
@@ -226,6 +241,11 @@ def _wing_text(op: OptimizationFile, result, source: str) -> str:
     ]
     if op.v_max is not None:
         lines.append(f"v_max = {_num(op.v_max)}")
+    if op.aero is not None:
+        lines.append('aero = "dlm"')
+    if op.mach is not None:
+        lines.append(f"mach = {_num(op.mach)}")
+    lines += dlm_toml(op.aero)
     d = op.damping.to_dict() if op.damping is not None and op.damping.active else {}
     if d:
         lines += ["", "[damping]"]

@@ -19,6 +19,7 @@ from ..errors import MAX_ELEMENTS, InputError
 from ..simulate.march import MAX_SAMPLES
 from ..stability.matched import COMPRESSIBILITY
 from ..studies.scenario import SCENARIO_KINDS, Scenario
+from .aero_tables import model_aero
 from .gust_loads_tables import gust_cross_check, gust_loads_tables
 from .lco_tables import lco_cross_check, lco_tables, section_table
 from .scenario_checks import cross_check
@@ -192,7 +193,9 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         raise InputError(f"{file}: flight.speed: missing; give speed [m/s] or speed_factor")
 
     md = top.table("model").check_keys(
-        (), ("elements", "wagner", "design_modes", "gust", "v_max", "pk", "compressibility")
+        (),
+        ("elements", "wagner", "design_modes", "gust", "v_max", "pk", "compressibility")
+        + ("aero", "mach", "dlm"),
     )
     comp = md.string("compressibility", "none", choices=COMPRESSIBILITY)
     if comp != "none":
@@ -205,6 +208,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         if kw["altitude"] is None:
             md.fail("compressibility", comp, "needs flight.altitude or flight.altitude_ft")
         kw["compressibility"] = comp
+    model_aero(md, kw, kind, section)
     if top.has("damping"):
         try:
             kw["damping"] = damping_from_dict(top.data["damping"], "damping")
@@ -319,8 +323,10 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     return scenario
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario file.
+def load_scenario(path: str | Path, model: dict | None = None) -> Scenario:
+    """Read and validate a scenario file; ``model``: keys that replace the file's ``[model]``
+    keys (``aero``, ``mach``, ``dlm`` (merged into ``[model.dlm]``), ...: the command line's
+    options; ``aero = "strip"`` drops ``[model.dlm]``, a ``mach`` the matched compressibility).
 
     Raises
     ------
@@ -328,8 +334,22 @@ def load_scenario(path: str | Path) -> Scenario:
         With the file, the key and the value of the first problem found.
     """
     path = Path(path)
+    data = read_toml(path)
+    if model:
+        md = data.get("model", {})
+        md = dict(md) if isinstance(md, dict) else md
+        if isinstance(md, dict):
+            if model.get("aero") == "strip":
+                md.pop("dlm", None)
+            if "mach" in model:
+                md.pop("compressibility", None)
+            dlm = md.get("dlm", {})
+            md.update(model)
+            if "dlm" in model and isinstance(dlm, dict):
+                md["dlm"] = {**dlm, **model["dlm"]}
+            data["model"] = md
     with one_line_errors():
-        return scenario_from_dict(read_toml(path), str(path), path.parent)
+        return scenario_from_dict(data, str(path), path.parent)
 
 
 def scenario_folder():

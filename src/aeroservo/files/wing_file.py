@@ -3,9 +3,10 @@
 A file has a ``[wing]`` table (``span``, ``[[wing.segments]]``, optional
 ``[[wing.control_surfaces]]`` with ``[[wing.control_surfaces.actuators]]``), an optional
 ``[analysis]`` table with defaults for ``density`` or ``altitude`` / ``altitude_ft``,
-``compressibility``, ``elements``, ``wagner``, ``v_max`` and ``n_modes``, and an optional
-``[damping]`` table (``ratio``, ``alpha`` and ``beta``, or ``g``). Every error names the file,
-the key and the value.
+``compressibility``, ``elements``, ``wagner``, ``v_max``, ``n_modes``, ``aero`` and ``mach``, an
+optional ``[dlm]`` table (doublet-lattice settings, :mod:`aeroservo.files.aero_tables`) and an
+optional ``[damping]`` table (``ratio``, ``alpha`` and ``beta``, or ``g``). Every error names
+the file, the key and the value.
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ ANALYSIS_KEYS = (
     "wagner",
     "v_max",
     "n_modes",
+    "aero",
+    "mach",
 )
 DAMPING_KEYS = ("ratio", "alpha", "beta", "g")
 
@@ -79,9 +82,16 @@ class AnalysisOptions:
     altitude : float or None
         Geopotential altitude [m] (standard atmosphere; replaces ``density``).
     compressibility : str or None
-        ``"prandtl-glauert"`` (Mach matched at the altitude) or None.
+        ``"prandtl-glauert"`` or ``"matched"`` (Mach matched to the speed at the altitude: the
+        Prandtl-Glauert correction of strip theory, the doublet lattice's own Mach number) or
+        None.
     damping : StructuralDamping
         Structural damping (default none).
+    aero : DoubletLattice or None
+        The doublet-lattice settings of ``aero = "dlm"`` (``[dlm]``); None: strip theory.
+    mach : float or None
+        A fixed Mach number [-] of the aerodynamics (None: not given; then 0, or matched with
+        ``compressibility``).
     """
 
     density: float = 1.225
@@ -92,6 +102,8 @@ class AnalysisOptions:
     altitude: float | None = None
     compressibility: str | None = None
     damping: StructuralDamping = NO_DAMPING
+    aero: object = None
+    mach: float | None = None
 
 
 def _check_keys(where: str, table: object, required: tuple, optional: tuple = ()) -> Mapping:
@@ -190,8 +202,11 @@ def segment_sweep(where: str, seg: Mapping) -> float:
     return check_sweep(f"{where}.sweep", seg.get("sweep", 0.0))
 
 
-def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOptions:
-    """Build :class:`AnalysisOptions` from the ``[analysis]`` table."""
+def analysis_from_dict(
+    data: Mapping, where: str = "analysis", dlm: object = None
+) -> AnalysisOptions:
+    """Build :class:`AnalysisOptions` from the ``[analysis]`` table (and the ``[dlm]`` table
+    of a wing file, ``dlm``)."""
     tbl = _check_keys(where, data, (), ANALYSIS_KEYS)
     opts = {}
     given = [k for k in ("density", "altitude", "altitude_ft") if k in tbl]
@@ -233,6 +248,12 @@ def analysis_from_dict(data: Mapping, where: str = "analysis") -> AnalysisOption
         opts["v_max"] = check_quantity(f"{where}.v_max", tbl["v_max"], "flight_speed")
     if "n_modes" in tbl:
         opts["n_modes"] = check_int(f"{where}.n_modes", tbl["n_modes"], lo=1)
+    if "aero" in tbl or "mach" in tbl or dlm is not None:
+        from .aero_tables import aero_options
+
+        opts["aero"], opts["mach"] = aero_options(
+            tbl, where, dlm, "dlm", opts.get("compressibility")
+        )
     return AnalysisOptions(**opts)
 
 
@@ -277,8 +298,8 @@ def load_wing(path: str | Path) -> tuple[Wing, AnalysisOptions]:
     data = read_toml(path, "wing file (TOML)")
     path = Path(path)
     try:
-        _check_keys("(top level)", data, ("wing",), ("analysis", "damping", "hinges"))
-        opts = analysis_from_dict(data.get("analysis", {}))
+        _check_keys("(top level)", data, ("wing",), ("analysis", "damping", "hinges", "dlm"))
+        opts = analysis_from_dict(data.get("analysis", {}), dlm=data.get("dlm"))
         if "damping" in data:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")

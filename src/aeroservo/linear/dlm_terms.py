@@ -3,7 +3,8 @@
 The structural unknowns are the modal coordinates of the model's aerodynamic basis (or its
 lowest ``n_modes``); the aeroelastic states and forces come from the rational-function
 approximation (:mod:`aeroservo.system.rfa_system`). The gust's GAFs, fitted in the lag-only form
-``C0 + sum_j C_j p / (p + g_j)``, become one gust state per lag root,
+``C0 + sum_j C_j p / (p + g_j)``, become one gust state per gust lag root (twice as many roots as
+the modal forces have, :data:`aeroservo.system.dlm_forces.GUST_LAG_FACTOR`),
 
 ``y_j' = (g_j V / b) (w_g - y_j)``,  force ``(rho V / 2) [(C0 + sum_j C_j) w_g - sum_j C_j y_j]``,
 
@@ -124,7 +125,7 @@ def dlm_terms(
         root_mnc=-0.5 * b * b * forces.A2[m:],
         Ks=Ks,
         Cs=Cs,
-        root_Ks=_dense(rt.Ks) @ basis,
-        root_Ms=_dense(rt.Ms) @ basis,
+        root_Ks=np.zeros((3, m)),  # force summation: the rigid motions do no elastic work
+        root_Ms=(dlm.rigid[: am.n_q].T @ _dense(am.Ms) + _dense(rt.Ms)) @ basis,
         gust_labels=tuple(labels),
     )

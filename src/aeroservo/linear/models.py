@@ -27,7 +27,8 @@ SAMPLE_RATES = (RANGES["sample_rate"].lo, RANGES["sample_rate"].hi)
 _BUILDER_KW = ("servo", "gust", "kussner", "n_modes", "mach")
 
 
-def _model_for(wing_or_model, n_elements: int, wagner: object):
+def _model_for(wing_or_model, n_elements: int, wagner: object, aero: object = "strip"):
+    from ..aero.dlm_settings import as_aero
     from ..structure.wing import Wing
     from ..system.aeroelastic import AeroelasticModel
 
@@ -37,10 +38,13 @@ def _model_for(wing_or_model, n_elements: int, wagner: object):
         raise InputError(
             f"wing = {describe(wing_or_model)}: expected an aeroservo.Wing or an AeroelasticModel"
         )
-    key = (wing_or_model, n_elements, wagner if isinstance(wagner, str) else None)
+    aero = as_aero(aero)
+    key = (wing_or_model, n_elements, wagner if isinstance(wagner, str) else None, aero)
     if key[2] is not None and key in _MODELS:
         return _MODELS[key]
-    model = AeroelasticModel(wing_or_model, n_elements, wagner)
+    model = AeroelasticModel(
+        wing_or_model, n_elements, wagner, aero="strip" if aero is None else aero
+    )
     if key[2] is not None:
         if len(_MODELS) > 16:
             _MODELS.clear()
@@ -84,6 +88,7 @@ def statespace(
     n_modes: int | None = None,
     balanced: bool = True,
     mach: float = 0.0,
+    aero: object = "strip",
 ):
     """Linear state-space model of a wing at one flight condition.
 
@@ -105,7 +110,11 @@ def statespace(
         ``x_physical = sys.state_scaling * x``); False: the physical states, see
         :meth:`StateSpaceBuilder.at`.
     mach : float
-        Mach number of the Prandtl-Glauert correction (0: incompressible; below 0.9).
+        Mach number of the Prandtl-Glauert correction (0: incompressible; below 0.9); of the
+        doublet lattice (below 1).
+    aero : {"strip", "dlm"}, dict or DoubletLattice
+        Aerodynamic model of a wing given as a Wing (see :class:`aeroservo.AeroelasticModel`;
+        an existing model keeps its own).
 
     Returns
     -------
@@ -115,7 +124,7 @@ def statespace(
     """
     check_number("speed", speed, unit="m/s", lo=0.0, hi=MAX_SPEED)
     _check_bool("balanced", balanced)
-    model = _model_for(wing, n_elements, wagner)
+    model = _model_for(wing, n_elements, wagner, aero)
     kw = {"mach": mach} if mach else {}  # the cached incompressible builder otherwise
     b = _builder_for(
         model,
@@ -148,14 +157,15 @@ def statespace_family(
     """
     n_el = kw.pop("n_elements", 10)
     wag = kw.pop("wagner", "rt_jones")
+    aero = kw.pop("aero", "strip")
     balanced = _check_bool("balanced", kw.pop("balanced", True))
     for k in kw:
         if k not in _BUILDER_KW:
-            allowed = ["n_elements", "wagner", "balanced", *_BUILDER_KW]
+            allowed = ["n_elements", "wagner", "aero", "balanced", *_BUILDER_KW]
             raise InputError(f"statespace_family: unknown argument {k!r}; allowed: {allowed}")
     if not (isinstance(speeds, (list, tuple, range)) or getattr(speeds, "ndim", 0) == 1):
         raise InputError(f"speeds = {describe(speeds)}: expected a sequence of speeds [m/s]")
-    model = _model_for(wing, n_el, wag)
+    model = _model_for(wing, n_el, wag, aero)
     return _builder_for(model, density, inputs, outputs, **kw).family(speeds, balanced=balanced)
 
 
@@ -206,10 +216,17 @@ def tip_deflection_state(plant, tip: float, *, balanced: bool | None = None) -> 
         raise InputError("tip_deflection_state: use the full-model plant (no n_modes)")
     model = builder.model
     f = np.zeros(model.n_dofs)
-    f[model.mesh.dof_w[-1]] = 1.0
-    q = np.linalg.solve(model.matrices.Ks.toarray(), f)
+    tip_w = model.mesh.dof_w[-1]
+    f[tip_w] = 1.0
+    ks = model.matrices.Ks.toarray()
     x = np.zeros(builder.n_states)
-    x[: model.n_dofs] = q * (tip / q[model.mesh.dof_w[-1]])
+    if builder.basis is None:
+        q = np.linalg.solve(ks, f)
+        x[: model.n_dofs] = q * (tip / q[tip_w])
+    else:  # a doublet-lattice model: the static shape on its modal basis
+        phi = builder.basis
+        eta = np.linalg.solve(phi.T @ ks @ phi, phi.T @ f)
+        x[: eta.size] = eta * (tip / (phi @ eta)[tip_w])
     if builder is plant:
         return x / builder.state_scaling if balanced in (None, True) else x
     scaling = np.asarray(plant.state_scaling)

@@ -113,7 +113,7 @@ class StateSpaceBuilder:
         self.kussner: IndicialSet = kussner_set(kussner)
         wing = model.wing
         self.inputs = resolve_inputs(wing, inputs)
-        n_avail = model.n_dofs
+        n_avail = model.n_dofs if model.dlm is None else model.dlm.n_a  # DLM: its modal basis
         if n_modes is not None:
             n_modes = check_int("n_modes", n_modes, lo=1, hi=n_avail)
         self.outputs = resolve_outputs(model, outputs, n_avail)

@@ -298,7 +298,9 @@ def plot_envelope(envelope, *, units: str = "si", x: str = "eas") -> Figure:
     ax.set_ylabel("altitude [km] (ISA, geopotential)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    comp = {"prandtl-glauert": "Prandtl-Glauert"}.get(envelope.compressibility, "incompressible")
+    comp = {"prandtl-glauert": "Prandtl-Glauert", "dlm": "doublet lattice"}.get(
+        envelope.compressibility, "incompressible"
+    )
     ax.set_title(
         f"{envelope.wing}: flutter envelope ({comp}; structural damping {envelope.damping})",
         fontsize=9,

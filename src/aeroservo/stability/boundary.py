@@ -227,7 +227,10 @@ def flutter_boundary(
         | ({"enlarged": enlarged} if enlarged else {}),
         "certificate": cert.to_dict(),
     }
-    return FlutterResult(
+    dlm = getattr(src, "dlm", None)
+    if dlm is not None:
+        warnings += src.dlm_fit(mach).warnings
+    result = FlutterResult(
         speeds=br.speeds,
         eigenvalues=lam,
         mode_labels=labels,
@@ -241,10 +244,16 @@ def flutter_boundary(
         warnings=warnings,
         exact=exact,
         mach=mach,
-        compressibility="prandtl-glauert" if mach > 0 else None,
+        compressibility=("prandtl-glauert" if mach > 0 else None) if dlm is None else "dlm",
         damping=_damping_text(src),
         near_critical=near,
     )
+    if dlm is not None:  # the RFA's onsets against the tabulated forces
+        from .rfa_check import rfa_onset_notes
+
+        notes, info["rfa_check"] = rfa_onset_notes(src, result, mach)
+        result.warnings.extend(notes)
+    return result
 
 
 def _modal(src, system: FirstOrderSystem, basis: ModalBasis | None, n_modes) -> ModalSystem:

@@ -101,7 +101,10 @@ def flutter_at(
     if comp is None:
         r = _flight(solver(model, rho, **kw), atmosphere, None, [])
         for what, v in (("flutter", r.flutter_speed), ("divergence", r.divergence_speed)):
-            note = None if v is None else mach_note(what, v, a)
+            if getattr(model, "dlm", None) is not None:
+                note = _dlm_mach_note(what, v, a, float(kw.get("mach", 0.0) or 0.0))
+            else:
+                note = None if v is None else mach_note(what, v, a)
             if note:
                 r.warnings.append(note)
         return r
@@ -183,7 +186,8 @@ def _residual(r: FlutterResult, a: float, mach: float) -> float:
 def _flight(r, atm: Atmosphere, comp, history) -> FlutterResult:
     r.altitude = atm.altitude
     r.speed_of_sound = atm.speed_of_sound
-    r.compressibility = comp
+    if r.compressibility != "dlm":  # a doublet-lattice result keeps its aerodynamics' name
+        r.compressibility = comp
     if history:
         r.info["mach_iterations"] = history
     return r
@@ -243,6 +247,16 @@ def _matched_dlm_divergence(model, rho: float, a: float) -> tuple[float | None, 
         return None, np.isfinite(v0)
     m = brentq(g, 0.0, DLM_TOP, xtol=1e-10, rtol=1e-12)
     return v_d(m), True
+
+
+def _dlm_mach_note(what: str, v: float | None, a: float, mach: float) -> str | None:
+    """A doublet-lattice result at a fixed Mach number far from its own ``V / a``."""
+    if v is None or abs(v / a - mach) <= 0.05 or max(v / a, mach) <= 0.3:
+        return None
+    return (
+        f"{what} at Mach {v / a:.3f} with the doublet lattice at Mach {mach:g}: match the Mach "
+        "number (compressibility = 'matched')"
+    )
 
 
 def _with_divergence(r: FlutterResult, v_div: float | None) -> FlutterResult:

@@ -75,9 +75,11 @@ class FlutterResult:
     speed_of_sound : float or None
         [m/s]; None when only the density is known (no Mach numbers then).
     mach : float
-        Mach number of the aerodynamics (Prandtl-Glauert correction; 0: incompressible).
+        Mach number of the aerodynamics (Prandtl-Glauert correction or the doublet lattice's;
+        0: incompressible).
     compressibility : str or None
-        ``"prandtl-glauert"`` or None.
+        ``"prandtl-glauert"`` (strip theory), ``"dlm"`` (the doublet lattice at ``mach``) or
+        None (incompressible strip theory).
     damping : str
         Structural damping of the model (e.g. ``"g = 0.03"``, ``"none"``).
     near_critical : list of NearCritical
@@ -255,7 +257,9 @@ class FlutterResult:
         else:
             text = f"density {self.density:g} kg/m^3"
         text += f"; structural damping {self.damping}"
-        if self.compressibility:
+        if self.compressibility == "dlm":
+            text += f"; doublet lattice at Mach {self.mach:.4g}"
+        elif self.compressibility:
             text += f"; {self.compressibility} at Mach {self.mach:.4g}"
         return text
 

@@ -110,6 +110,9 @@ class GustLoadsStudy:
         Flight profile alleviation factor; None: from ``weights`` at each altitude.
     weights : dict
         ``mlw, mzfw, mtow`` [kg] and ``z_mo`` [m] of CS-25.341(a)(6).
+    aero : {"strip", "dlm"}, DoubletLattice or None
+        Aerodynamic model of every mass case (None: strip theory; the doublet lattice at
+        Mach 0, as the control loop is built).
     """
 
     mass_cases: dict
@@ -138,8 +141,12 @@ class GustLoadsStudy:
     n_gradients: int = 20
     turbulence: bool = True
     name: str = "gust_loads"
+    aero: object = None
 
     def __post_init__(self) -> None:
+        from ..aero.dlm_settings import as_aero
+
+        object.__setattr__(self, "aero", as_aero(self.aero))
         if not self.mass_cases:
             raise InputError("gust loads: give at least one mass case (a wing)")
         if not self.points:
@@ -175,7 +182,8 @@ class GustLoadsStudy:
         from ..system.aeroelastic import AeroelasticModel
 
         wing = self.mass_cases[mass_case]
-        return AeroelasticModel(wing, self.elements, self.wagner, damping=self.damping)
+        aero = "strip" if self.aero is None else self.aero
+        return AeroelasticModel(wing, self.elements, self.wagner, damping=self.damping, aero=aero)
 
     def loop(self, mass_case: str, density: float):
         """The :class:`~aeroservo.design.loop.ControlLoop` (or, open loop only, a plain builder

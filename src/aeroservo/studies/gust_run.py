@@ -29,6 +29,7 @@ def _settings(study: GustLoadsStudy) -> dict:
         "f_g": study.f_g,
         "weights": dict(study.weights),
         "elements": study.elements,
+        **({} if study.aero is None else {"aero": "dlm", "dlm": study.aero.to_dict()}),
         "gust_model": study.gust_model,
         "sample_rate": study.sample_rate,
         "delay": study.delay,

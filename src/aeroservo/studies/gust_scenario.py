@@ -66,6 +66,7 @@ def gust_study(scenario: Scenario):
         n_gradients=g["n_gradients"],
         turbulence=g["turbulence"],
         name=scenario.result,
+        aero=scenario.aero,
     )
 
 

@@ -134,12 +134,15 @@ def _describing(setup: LCOSetup, sweep: LCOSweep):
         return b, "describing function: of the sampled loop, actuator limits inactive"
     model = setup.loop.model if setup.loop is not None else setup.model
     system = model.system(setup.density)
+    elements = setup.elements
+    if getattr(model, "dlm", None) is not None:  # its systems are on the aerodynamic basis
+        elements = elements.project(model.dlm.basis)
     small = system.n_states <= 40  # a section: fine grids; a wing: coarser (eig per speed)
     amps = _amplitudes(setup, sweep, 120 if small else 36)
     lo, hi = (0.5, 1.5) if small else (0.8, 1.2)
     speeds = np.linspace(lo * v.min(), hi * v.max(), 240 if small else 80)
     try:
-        return describing_branches(system, setup.elements, amps, speeds=speeds), None
+        return describing_branches(system, elements, amps, speeds=speeds), None
     except (InputError, ArithmeticError) as exc:
         return None, f"describing function: not computed ({exc})"
 

@@ -74,6 +74,8 @@ def optimize_wing(
     v_max: float | None = None,
     gradients: str = "analytic",
     max_iterations: int = 60,
+    aero: object = "strip",
+    mach: float | None = None,
 ) -> Optimization:
     """Choose wing parameters by SLSQP.
 
@@ -97,6 +99,12 @@ def optimize_wing(
         Where an analytic derivative does not exist at an iterate (a mode switch, an actuator
         on a mesh node) that iterate's gradient is a central difference, and its log says why.
     max_iterations : int
+    aero : {"strip", "dlm"}, dict or DoubletLattice
+        Aerodynamic model (:class:`aeroservo.AeroelasticModel`); the doublet lattice's
+        "analytic" gradients are central finite differences of its boundaries
+        (:func:`aeroservo.stability.sensitivity.flutter_sensitivities`).
+    mach : float, optional
+        Fixed Mach number of the aerodynamics (default 0).
 
     Returns
     -------
@@ -124,8 +132,10 @@ def optimize_wing(
     logged: dict = {}  # cache key -> (its entry of log, designs and boundaries so far)
     iterates: list = []  # (x, designs analysed, boundaries) after each iteration
 
+    fb = {"v_max": v_max, **({"mach": mach} if mach else {})}  # each boundary's options
+
     def make(w):
-        return AeroelasticModel(w, n_elements, wagner, damping=damping)
+        return AeroelasticModel(w, n_elements, wagner, damping=damping, aero=aero)
 
     def key_of(x: np.ndarray) -> tuple:
         return tuple(np.round(x, 14))
@@ -138,7 +148,7 @@ def optimize_wing(
             if gradients == "analytic":
                 count[0] += 1
                 moved = with_parameters(wing, dict(zip(names, p, strict=True)))
-                s = flutter_sensitivities(make(moved), density, [*names], v_max=v_max)
+                s = flutter_sensitivities(make(moved), density, [*names], **fb)
                 vf, vd = s.flutter_speed, s.divergence_speed
                 why = s.non_differentiable or next(
                     (f"{n}: {s.undefined[n]}" for n in names if n in s.undefined), None
@@ -148,7 +158,7 @@ def optimize_wing(
                 if why is not None and vf is not None:
                     how = f"central ({why})"
             if how != "analytic":
-                vf, vd, dvf, dvd = _central(make, wing, names, p, scale, density, v_max, count)
+                vf, vd, dvf, dvd = _central(make, wing, names, p, scale, density, fb, count)
             top = v_max if v_max is not None else np.inf
             cache[key] = (vf if vf is not None else top, vd if vd is not None else top, dvf, dvd)
             log.append(
@@ -204,7 +214,7 @@ def optimize_wing(
     iterate(sol.x)
     best = dict(zip(names, map(float, sol.x * scale), strict=True))
     check = flutter_boundary(
-        make(with_parameters(wing, best)), density, v_max=v_max
+        make(with_parameters(wing, best)), density, **fb
     )  # a fresh model and analysis
     values = {"flutter_speed": check.flutter_speed, "divergence_speed": check.divergence_speed}
     active, margins = [], {}
@@ -229,7 +239,7 @@ def optimize_wing(
         """Flutter and divergence speed of an iterate, designs and boundaries analysed then."""
         if key_of(x) not in logged:  # never analysed by SLSQP (no speed in the problem)
             moved = with_parameters(wing, dict(zip(names, x * scale, strict=True)))
-            r = flutter_boundary(make(moved), density, v_max=v_max)  # a fresh look
+            r = flutter_boundary(make(moved), density, **fb)  # a fresh look
             return r.flutter_speed, r.divergence_speed, 0, 0
         entry, n_designs, n_boundaries = logged[key_of(x)]
         return entry["flutter_speed"], entry["divergence_speed"], n_designs, n_boundaries
@@ -329,14 +339,14 @@ def _constraints(constraints: object) -> dict:
     return out
 
 
-def _central(make, wing, names, p, scale, density, v_max, count):
+def _central(make, wing, names, p, scale, density, fb, count):
     """Speeds and their gradients by central differences (relative step 1e-5); ``make``
-    builds the model of a wing."""
+    builds the model of a wing, ``fb`` the options of its boundaries."""
 
     def speeds(q):
         count[0] += 1
         m = make(with_parameters(wing, dict(zip(names, q, strict=True))))
-        r = flutter_boundary(m, density, v_max=v_max, rtol=1e-12)
+        r = flutter_boundary(m, density, rtol=1e-12, **fb)
         return r.flutter_speed, r.divergence_speed
 
     vf, vd = speeds(p)

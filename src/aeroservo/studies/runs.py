@@ -92,20 +92,15 @@ def _progress_bar(total: float, desc: str, enabled: bool, unit: str = "m/s"):
 @blas_limited
 def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
     """Open-loop flutter and divergence of the scenario's wing (summary and V-g figure)."""
-    from ..stability.boundary import flutter_boundary
+    from .flight_condition import aero_record, flutter_at_condition, mach_source
 
     model = scenario.model()
     atm = scenario.atmosphere
+    cond = (model, scenario.density, atm, scenario.compressibility, scenario.mach)
     update, close = _progress_bar(scenario.v_max or 300.0, "flutter sweep", progress)
     try:
-        if atm is not None:
-            from ..stability.matched import flutter_at
-
-            fr = flutter_at(
-                model, atm, compressibility=scenario.compressibility, v_max=scenario.v_max
-            )
-        else:
-            fr = flutter_boundary(model, scenario.density, v_max=scenario.v_max, progress=update)
+        kw = {} if atm is not None else {"progress": update}
+        fr = flutter_at_condition(*cond, v_max=scenario.v_max, **kw)
     finally:
         close()
     summary = {
@@ -120,29 +115,21 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
         "n_elements": model.n_elements,
         "wagner": model.wagner.name,
         "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3"},
+        **aero_record(model, fr.mach, mach_source(scenario.compressibility, scenario.mach, atm)),
     }
     summary.update({k: v for k, v in fr.to_dict().items() if k not in summary})
     if scenario.pk:
         from ..stability.pk import pk_flutter
 
-        if atm is not None:
-            from ..stability.matched import flutter_at
-
-            pk = flutter_at(
-                model,
-                atm,
-                compressibility=scenario.compressibility,
-                solver=pk_flutter,
-                v_max=fr.v_max,
-            )
-        else:
-            pk = pk_flutter(model, scenario.density, v_max=fr.v_max, boundary=fr)
-        summary["pk_exact_theodorsen"] = {
+        kw = {"boundary": fr} if atm is None else {}
+        pk = flutter_at_condition(*cond, solver=pk_flutter, v_max=fr.v_max, **kw)
+        summary["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,
         }
 
-    title = f"{scenario.wing.name}: {model.n_elements} elements, {model.wagner.name}"
+    aero = model.wagner.name if model.dlm is None else f"doublet lattice, Mach {fr.mach:.3g}"
+    title = f"{scenario.wing.name}: {model.n_elements} elements, {aero}"
     return Run(scenario, summary, flutter=fr, title=title)
 
 
@@ -214,6 +201,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         "controller_type": spec.type,
         "speed": speed,
         "density": scenario.density,
+        "aero": model.aero_model,
         "open_loop_flutter_speed": vf,
         "open_loop_flutter_frequency": fr.flutter_frequency,
         "speed_over_flutter_speed": None if vf is None else speed / vf,
@@ -379,6 +367,7 @@ def study_from_scenario(scenario: Scenario):
         damping=scenario.damping,
         elements=scenario.elements,
         wagner=scenario.wagner,
+        aero=scenario.aero,
         controls=tuple(scenario.controls),
         sensors=tuple(scenario.sensors),
         outputs=tuple(scenario.outputs),

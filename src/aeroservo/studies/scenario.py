@@ -52,7 +52,10 @@ class Scenario:
     (``hinges``, ``speeds``, ``amplitudes``, ``duration``, ``dt``, ``settle``, ``continuation``,
     ``history``, ``workers``, ``describing``, ``hinges_source``); None for the other kinds. A
     limit-cycle study on a typical section has ``section`` (a
-    :class:`~aeroservo.system.section.TypicalSection`) and no ``wing``.
+    :class:`~aeroservo.system.section.TypicalSection`) and no ``wing``. ``aero`` is the
+    doublet-lattice settings (a :class:`~aeroservo.aero.dlm_settings.DoubletLattice`; None:
+    strip theory) and ``mach`` a fixed Mach number (None: 0, or matched with
+    ``compressibility``).
     """
 
     name: str
@@ -99,6 +102,8 @@ class Scenario:
     gust_loads: object = None
     lco: object = None
     section: object = None
+    aero: object = None
+    mach: float | None = None
 
     def model(self):
         """The aeroelastic model of the scenario's wing and options (its typical section, if
@@ -108,7 +113,13 @@ class Scenario:
         if self.section is not None:
             return self.section
 
-        return AeroelasticModel(self.wing, self.elements, self.wagner, damping=self.damping)
+        return AeroelasticModel(
+            self.wing,
+            self.elements,
+            self.wagner,
+            damping=self.damping,
+            aero="strip" if self.aero is None else self.aero,
+        )
 
     def engaged_range(self, flutter_speed: float | None, speed: float):
         """The speeds where the loop is engaged (:class:`~aeroservo.design.EngagedRange`):

@@ -77,12 +77,13 @@ def _stage_model(study: TradeStudy, wing: Wing) -> dict:
     from ...stability.boundary import flutter_boundary
     from ...system.aeroelastic import AeroelasticModel
 
-    key = (repr(wing), study.density, study.elements, study.wagner, study.damping)
+    key = (repr(wing), study.density, study.elements, study.wagner, study.damping, study.aero)
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
         return hit
-    model = AeroelasticModel(wing, study.elements, study.wagner, damping=study.damping)
+    aero = "strip" if study.aero is None else study.aero
+    model = AeroelasticModel(wing, study.elements, study.wagner, damping=study.damping, aero=aero)
     entry = {"model": model, "flutter": flutter_boundary(model, study.density), "loops": {}}
     _CACHE[key] = entry
     while len(_CACHE) > _CACHE_SIZE:

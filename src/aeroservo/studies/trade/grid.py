@@ -52,6 +52,8 @@ def study_settings(study: TradeStudy) -> dict:
     }
     if study.damping.active:  # only then: undamped studies keep their case ids
         s["damping"] = study.damping.to_dict()
+    if study.aero is not None:  # the doublet lattice (strip studies keep their case ids)
+        s["aero"] = study.aero.to_dict()
     if study.closed_loop:
         spec = _jsonable(study.controller)
         for k in ("name", "source"):  # labels only: they do not change the results

@@ -136,11 +136,6 @@ _BRYSON_TYPES = ("lqr", "lqg", "mpc", "hinf")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
-# --------------------------------------------------------------------------------------------
-# The study
-# --------------------------------------------------------------------------------------------
-
-
 @dataclass(frozen=True, kw_only=True)
 class TradeStudy:
     """A grid of flutter-suppression cases (all fields keyword-only, validated).
@@ -157,6 +152,8 @@ class TradeStudy:
         Beam elements along the span.
     wagner : str
         Wagner approximation (see :class:`aeroservo.AeroelasticModel`).
+    aero : {"strip", "dlm"}, DoubletLattice or None
+        Aerodynamic model of every variant (None: strip theory; the doublet lattice at Mach 0).
     controls, sensors, outputs : tuple of str
         Control inputs, measured outputs and further recorded outputs of the loop
         (see :class:`aeroservo.design.loop.ControlLoop`); ``"tip_accel"`` must be among the
@@ -203,6 +200,7 @@ class TradeStudy:
     damping: StructuralDamping = NO_DAMPING
     elements: int = 10
     wagner: str = "rt_jones"
+    aero: object = None
     controls: tuple = ("aileron_hinge_moment",)
     sensors: tuple = ("tip_le_accel", "tip_te_accel", "tip_twist")
     outputs: tuple = ("tip_disp", "tip_accel")
@@ -223,6 +221,7 @@ class TradeStudy:
     closed_loop: bool = True
 
     def __post_init__(self) -> None:
+        from ...aero.dlm_settings import as_aero
         from ...aero.indicial import wagner_set
 
         put = object.__setattr__
@@ -240,6 +239,7 @@ class TradeStudy:
         if not isinstance(self.wagner, str):
             raise InputError(f"wagner = {self.wagner!r}: expected the name of a Wagner set")
         wagner_set(self.wagner)
+        put(self, "aero", as_aero(self.aero))
         for key in ("controls", "sensors", "outputs"):
             put(self, key, _names(key, getattr(self, key)))
         if not self.controls and self.closed_loop is not False:
