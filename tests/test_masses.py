@@ -384,8 +384,8 @@ def test_wing_file_round_trip(tmp_path):
     [
         ("station = 0.0\nmass = 10.0", "wing.masses[0].station = 0: allowed range is (0,"),
         ("station = 7.0\nmass = 10.0", "wing.masses[0].station = 7: outside the wing"),
-        ("station = 3.0\nmass = -1.0", "wing.masses[0].mass = -1: allowed range is (0, 1e+06]"),
-        ("station = 3.0\nmass = 1e9", "wing.masses[0].mass = 1e+09: allowed range is (0, 1e+06]"),
+        ("station = 3.0\nmass = -1.0", "wing.masses[0].mass = -1: allowed range is [0, 1e+06]"),
+        ("station = 3.0\nmass = 1e9", "wing.masses[0].mass = 1e+09: allowed range is [0, 1e+06]"),
         ("station = 3.0\nmass = 1.0\ninertia = -2.0", "wing.masses[0].inertia = -2"),
         ("station = 3.0\nmass = 1.0\noffset = 250.0", "wing.masses[0].offset = 250: allowed"),
         (

@@ -398,7 +398,7 @@ BAD = {
     "missing property": (lambda m: setattr(m.elements[2], "pid", 99), "property 99 is missing"),
     "unsupported card": (
         lambda m: (m.add_prod(50, 1, 0.01), m.add_crod(50, 50, [1, 2])),
-        "card CROD",
+        "CROD 50 (1 card): rods carry no bending",
     ),
     "sweep beyond 60 deg": (
         lambda m: setattr(m.nodes[2], "xyz", m.nodes[1].xyz + [5.0, 0.1, 0.0]),

@@ -156,7 +156,7 @@ RANGES: dict[str, Range] = {
     "flap_stiffness": Range(0.0, 1e13, "N m^2"),
     "hinge_stiffness": Range(0.0, 1e12, "N m/rad per m"),
     "actuator_stiffness": Range(0.0, 1e12, "N m/rad", lo_open=True),
-    "point_mass": Range(0.0, 1e6, "kg", lo_open=True),
+    "point_mass": Range(0.0, 1e6, "kg"),
     "point_inertia": Range(0.0, 1e7, "kg m^2"),
     # aerodynamics
     "wagner_coefficient": Range(0.0, 1.0, lo_open=True),

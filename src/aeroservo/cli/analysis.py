@@ -142,14 +142,20 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         **aero_record(model, result.mach, source),
     }
     out.update({k: v for k, v in result.to_dict().items() if k not in out})
-    pk = None
-    if args.pk:
+    pk, sol = None, None
+    if s.sol145 is not None and s.sol145["velocities"]:
+        from ..studies.flight_condition import sol145_at_condition
+
+        pk, sol = sol145_at_condition(cond, result, s.sol145)
+        out["sol145"] = sol.to_dict()
+    elif args.pk or s.sol145 is not None:  # a deck's K or KE case: p-k over the speed range
         from ..stability.pk import pk_flutter
 
         kw["v_max"] = result.v_max
         if s.atmosphere is None:
             kw["boundary"] = result
         pk = flutter_at_condition(*cond, solver=pk_flutter, **kw)
+    if pk is not None:
         from ..stability.near_critical import method_discrepancy
 
         note = method_discrepancy(result, pk, model.semichord, model.wagner.name)
@@ -213,6 +219,14 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
         else:
             text = pk.speed_text(pk.flutter_speed, args.units)
             print(f"p-k ({how}): flutter {text} at {pk.flutter_frequency:.5g} Hz")
+    if sol is not None:
+        print(f"\nNastran flutter summary ({sol.method} velocities of the deck, aeroservo's p-k):")
+        print(sol.text())
+    elif s.sol145 is not None:
+        print(
+            f"the deck's {s.sol145['method']} case lists reduced frequencies, not velocities: "
+            "p-k over the speed range above (give sol145.velocities [m/s] for a flutter summary)"
+        )
     for key, what in (("plot", "plot"), ("saved", "sweep"), ("table", "table")):
         if key in out:
             print(f"{what} written to {out[key]}")

@@ -6,6 +6,10 @@ import argparse
 
 from .options import quantity
 
+UNIT_NAMES = ("si", "in-lbf-s", "ft-slug-s", "mm-t-s")
+"""The unit systems of ``--units`` (``files/nastran_units.UNIT_SYSTEMS``, not imported here to
+keep the parser free of numpy)."""
+
 __all__ = ["add_parsers", "HANDLERS"]
 
 
@@ -30,18 +34,32 @@ def add_parsers(sub) -> None:
     formats = p.add_subparsers(dest="format", required=True, metavar="FORMAT")
     nas = formats.add_parser(
         "nastran",
-        help="a cantilever stick model: GRID, CBAR/CBEAM, PBAR/PBARL/PBEAM, MAT1, CONM2, "
-        "CMASS2, SPC",
-        description="Read a Nastran cantilever stick model (bulk data in SI units, read with "
-        "pyNastran: pip install 'aeroservo[nastran]') and write a wing file with a comment on "
-        "each value saying where it came from. A beam deck has no aerodynamic chord: give the "
-        "chord and the elastic axis here or in a companion table (docs/nastran.md).",
+        help="a cantilever stick model (CBAR/CBEAM, masses, SPC) with its aero and flutter "
+        "cards (CAERO1, SPLINE, FLUTTER)",
+        description="Read a Nastran cantilever stick model (read with pyNastran: pip install "
+        "'aeroservo[nastran]') and write a wing file with a comment on each value saying where "
+        "it came from, converted to SI from the units given. The chord and elastic axis come "
+        "from the deck's CAERO1 panels, or from the options or a companion table; a deck with a "
+        "FLUTTER card also gets a flutter scenario <out>_flutter.toml (docs/nastran.md).",
     )
     nas.add_argument("deck", help="Nastran bulk data (.bdf, .dat, .nas)")
     nas.add_argument("--out", required=True, metavar="FILE", help="wing file to write (.toml)")
+    nas.add_argument(
+        "--units",
+        choices=tuple(UNIT_NAMES),
+        default="si",
+        help="the deck's unit system (default si: N, m, kg, s); converted to SI once",
+    )
     chord = nas.add_mutually_exclusive_group()
-    chord.add_argument("--chord", type=quantity("semichord"), metavar="C", help="chord [m]")
-    chord.add_argument("--semichord", type=quantity("semichord"), metavar="B", help="[m]")
+    chord.add_argument(
+        "--chord",
+        type=quantity("semichord"),
+        metavar="C",
+        help="chord [m] normal to the beam (default: from the CAERO1 panels)",
+    )
+    chord.add_argument(
+        "--semichord", type=quantity("semichord"), metavar="B", help="[m], normal to the beam"
+    )
     nas.add_argument(
         "--elastic-axis",
         type=_elastic_axis,
@@ -67,8 +85,16 @@ def _cmd_import(args: argparse.Namespace) -> int:
         elastic_axis=args.elastic_axis,
         companion=args.companion,
         name=args.name,
+        units=args.units,
     )
     print(f"wrote {args.out}: {result.summary}")
+    if result.scenario is not None:
+        from ..files.nastran import scenario_path
+
+        print(
+            f"wrote {scenario_path(args.out)}: run it with 'aeroservo flutter "
+            f"{scenario_path(args.out)}'"
+        )
     return 0
 
 

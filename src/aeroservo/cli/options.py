@@ -153,6 +153,7 @@ class Setup:
     compressibility: str | None
     opts: object
     mach: float | None = None  # a fixed Mach number (None: 0, or matched with compressibility)
+    sol145: dict | None = None  # a scenario's Nastran flutter case (``[sol145]``)
 
 
 def _damping(args, default):
@@ -264,7 +265,8 @@ def setup(args: argparse.Namespace, altitudes: bool = False) -> Setup:
         model = AeroelasticModel(
             wing, elements, wagner, damping=_damping(args, opts.damping), aero=aero or "strip"
         )
-    return Setup(wing, model, atm, density, comp, opts, mach)
+    sol145 = sc.sol145 if scenario else None
+    return Setup(wing, model, atm, density, comp, opts, mach, sol145)
 
 
 def check_figure(path: str | None, option: str = "--plot") -> None:

@@ -10,17 +10,34 @@ card, and what a deck must give: ``docs/nastran.md``.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import InputError
 from ..structure.wing import Wing
-from .nastran_beam import beam_line, point_masses, segments
+from .nastran_beam import beam_line, segments
+from .nastran_case import (
+    analysis_tables,
+    case_v_max,
+    panel_geometry,
+    scenario_text,
+    surface_geometry,
+)
 from .nastran_companion import import_options
 from .nastran_deck import read_deck
+from .nastran_units import chord_hint
+from .nastran_wing_masses import point_masses
 from .wing_file import wing_from_dict, wing_toml
 
-__all__ = ["NastranImport", "import_nastran", "read_nastran", "write_nastran_wing"]
+__all__ = [
+    "NastranImport",
+    "import_nastran",
+    "read_nastran",
+    "write_nastran_wing",
+    "scenario_path",
+]
 
 
 @dataclass(frozen=True)
@@ -31,6 +48,8 @@ class NastranImport:
     text: str
     summary: str
     left_out: tuple[str, ...]
+    scenario: str | None = None  # the deck's flutter case as a flutter scenario (TOML)
+    aero: object | None = None  # the deck's aerodynamic cards (files/nastran_aero.AeroDeck)
 
 
 def import_nastran(deck: str | Path, **options) -> Wing:
@@ -39,12 +58,15 @@ def import_nastran(deck: str | Path, **options) -> Wing:
     Parameters
     ----------
     deck : str or Path
-        Bulk data of a cantilever beam (GRID, CORD1R/CORD2R, CBAR/CBEAM, PBAR/PBARL/PBEAM,
-        MAT1, CONM2, CMASS2, SPC/SPC1), SI units (N, m, kg; ``PARAM,WTMASS`` is applied).
+        Bulk data of a cantilever beam (GRID, GRDSET, CORD1R/CORD2R, CBAR/CBEAM, PBAR/PBARL/
+        PBEAM/PBEAML, MAT1, CONM2, CONM1, CMASS1/CMASS2, SPC/SPC1) with, optionally, its
+        aerodynamic and flutter cards (AERO, CAERO1, SPLINE1/2, SET1, AESURF, AELIST,
+        MKAERO1/2, FLFACT, FLUTTER); ``PARAM,WTMASS`` is applied.
     **options
-        ``chord`` or ``semichord`` [m], ``elastic_axis`` (a, semichords aft of mid-chord),
-        ``x_alpha`` [-], ``inertia`` [kg m], ``name``, ``companion`` (a TOML table,
-        ``docs/nastran.md``).
+        ``units`` (``"si"``, ``"in-lbf-s"``, ``"ft-slug-s"``, ``"mm-t-s"``; default SI),
+        ``chord`` or ``semichord`` [m, normal to the beam; default from the CAERO1 panels],
+        ``elastic_axis`` (a, semichords aft of mid-chord), ``x_alpha`` [-], ``inertia``
+        [kg m], ``name``, ``companion`` (a TOML table, ``docs/nastran.md``).
 
     Raises
     ------
@@ -65,9 +87,12 @@ def read_nastran(
     inertia: float | None = None,
     name: str | None = None,
     companion: str | Path | None = None,
+    units: str | None = None,
+    wing_file: str | Path = "wing.toml",
 ) -> NastranImport:
-    """Import a deck: the wing, the commented wing file text and a summary (see
-    :func:`import_nastran` for the parameters)."""
+    """Import a deck: the wing, the commented wing file text, a summary and the flutter
+    scenario of its aero and flutter cards (see :func:`import_nastran` for the parameters;
+    ``wing_file`` is the name the scenario gives the wing file)."""
     path = Path(deck)
     opts = import_options(
         companion,
@@ -78,20 +103,29 @@ def read_nastran(
         inertia=inertia,
         name=name,
     )
-    data = read_deck(path)
+    data = read_deck(path, units)
+    aero = data.aero
+    if aero is not None and not _given_flow(opts):
+        opts = replace(opts, free_stream=aero.flow)
     root, line = beam_line(data, opts)
+    geometry, surface_geo = {}, {}
+    if aero is not None:
+        geometry = panel_geometry(path, aero, line, data.grids, opts.up)
+        surface_geo = surface_geometry(aero, line, data.grids, opts.up)
     try:
-        segs, headers, sources = segments(line, opts)
+        segs, headers, sources = segments(line, opts, geometry)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
     masses, mass_notes, left = point_masses(data, root, line, opts.up)
     span = line[-1].end
+    chord_hint(path, span, segs, sources, data.units)
     surfaces = ()
     if opts.control_surfaces:
         rows = [{k: getattr(s, k) for k in _SEGMENT_KEYS} for s in segs]
+        tables = [{**surface_geo.get(t.get("name"), {}), **t} for t in opts.control_surfaces]
         try:
             surfaces = wing_from_dict(
-                {"span": span, "segments": rows, "control_surfaces": opts.control_surfaces}
+                {"span": span, "segments": rows, "control_surfaces": tables}
             ).control_surfaces
         except InputError as exc:
             msg = str(exc).replace("wing.control_surfaces", "control_surfaces")
@@ -107,8 +141,20 @@ def read_nastran(
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
     left = [*left, *_unused_grids(data, line, root)]
-    notes = list(data.notes)
-    text = _commented(wing, path, opts, headers, sources, mass_notes, notes, left)
+    notes = [data.units.describe(), *data.notes]
+    tables, scenario = "", None
+    if aero is not None:
+        v_max = case_v_max(aero, _frequencies(wing, len(line), aero))
+        try:
+            tables = analysis_tables(aero, len(line), notes, v_max)
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}") from None
+        notes += _surface_notes(aero, surface_geo, surfaces)
+        args = (str(wing_file), wing.name, path, data.units, len(line), v_max)
+        scenario = scenario_text(aero, *args)
+    text = _commented(wing, path, opts, headers, sources, mass_notes, notes, left) + (
+        f"\n{tables}" if tables else ""
+    )
     sweeps = [s.sweep for s in segs]
     swept = (
         ""
@@ -122,17 +168,68 @@ def read_nastran(
         f"{len(surfaces)} control surface{'s' * (len(surfaces) != 1)}"
         + (f"; left out: {'; '.join(left)}" if left else "")
     )
-    return NastranImport(wing, text, summary, tuple(left))
+    if aero is not None:
+        summary += f"; {len(aero.panels)} CAERO1 panel{'s' * (len(aero.panels) != 1)}"
+        if aero.flutter is not None:
+            summary += f", flutter case {aero.flutter.cards}"
+    return NastranImport(wing, text, summary, tuple(left), scenario, aero)
+
+
+def scenario_path(out: str | Path) -> Path:
+    """Where the flutter scenario of a wing file ``out`` goes: ``<stem>_flutter.toml``."""
+    out = Path(out)
+    return out.with_name(f"{out.stem}_flutter.toml")
 
 
 def write_nastran_wing(deck: str | Path, out: str | Path, **options) -> NastranImport:
-    """Import ``deck`` and write its wing file to ``out`` atomically (nothing on failure)."""
-    from ..atomic import atomic_write_text, check_output_path
+    """Import ``deck`` and write its wing file to ``out``, and its flutter case to
+    :func:`scenario_path` when it has one, as one set (nothing on failure)."""
+    from ..atomic import atomic_write_set, check_output_path
 
     check_output_path(out, "--out")
-    result = read_nastran(deck, **options)
-    atomic_write_text(out, result.text)
+    if Path(out).resolve() == Path(deck).resolve():
+        raise InputError(f"--out = {out}: that is the deck itself; name another file")
+    result = read_nastran(deck, wing_file=Path(out).name, **options)
+    files = [(Path(out), result.text)]
+    if result.scenario is not None:
+        files.append((scenario_path(out), result.scenario))
+    atomic_write_set([(p, lambda q, t=t: q.write_text(t, encoding="utf-8")) for p, t in files])
     return result
+
+
+def _frequencies(wing: Wing, n_elements: int, aero) -> list[float]:
+    """In-vacuo frequencies [Hz] of the modes a K or KE flutter case follows (LMODES, else 3)."""
+    if aero.flutter is None or aero.flutter.velocities:
+        return []
+    from ..system.aeroelastic import AeroelasticModel
+
+    model = AeroelasticModel(wing, max(n_elements, 2) if n_elements <= 300 else 300)
+    n = min(aero.lmodes or 3, model.n_dofs)
+    return list(model.natural_modes(n).frequencies)
+
+
+def _given_flow(opts) -> bool:
+    """Whether the companion table gave a flow direction other than the default +X."""
+    return not np.allclose(opts.free_stream, [1.0, 0.0, 0.0])
+
+
+def _surface_notes(aero, geometry: dict, surfaces) -> list[str]:
+    """One note per AESURF: the control surface it gives, or what to add to use it."""
+    named = {cs.name for cs in surfaces}
+    out = []
+    for label, geo in geometry.items():
+        where = (
+            f"AESURF {label}: {geo['start']:.6g} to {geo['end']:.6g} m along the beam, hinge "
+            f"{geo['hinge']:.6g} semichords aft of mid-chord (its boxes' forward edge)"
+        )
+        if label in named:
+            out.append(f"{where}: the control surface '{label}'")
+        else:
+            out.append(
+                f'{where}: not in the wing; give [[control_surfaces]] name = "{label}" with its '
+                "inertia, static moment and hinge stiffness in the companion table to add it"
+            )
+    return out
 
 
 _SEGMENT_KEYS = ("start", "end", "semichord", "a", "mass", "x_alpha", "inertia", "EI", "GJ")

@@ -18,15 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..structure.wing import MAX_SWEEP, ConcentratedMass, Segment, check_sweep
+from ..structure.wing import MAX_SWEEP, Segment, check_sweep
 from .nastran_companion import ImportOptions
-from .nastran_deck import Deck, Element
+from .nastran_deck import Deck, Element, vector_text
 
 __all__ = [
     "BeamElement",
     "beam_line",
     "element_values",
-    "point_masses",
     "segments",
     "PLANE_TOLERANCE",
 ]
@@ -163,7 +162,7 @@ def beam_line(deck: Deck, opts: ImportOptions) -> tuple[int, list[BeamElement]]:
         if abs(rise) > PLANE_TOLERANCE:
             raise InputError(
                 f"{where}: {math.degrees(rise):.3g} deg out of the wing plane (normal to up = "
-                f"{list(np.round(up, 6))}): dihedral and bent beam lines are not modelled "
+                f"{vector_text(up)}): dihedral and bent beam lines are not modelled "
                 "(aeroservo's wing is flat; only in-plane sweep kinks are allowed)"
             )
         sp = _unit(s - (s @ up) * up)
@@ -216,13 +215,19 @@ def _flap_plane(deck: Deck, e: Element, up: np.ndarray) -> tuple[str, np.ndarray
     )
 
 
-def element_values(be: BeamElement, opts: ImportOptions) -> dict[str, tuple[float, str]]:
-    """Segment values of one element, key -> (value, where it came from)."""
+def element_values(
+    be: BeamElement, opts: ImportOptions, geometry: dict | None = None
+) -> dict[str, tuple[float, str]]:
+    """Segment values of one element, key -> (value, where it came from); ``geometry``: the
+    semichord and elastic axis of each element from the deck's CAERO1 panels (by element id),
+    used where the options give none."""
     sec, e = be.element.section, be.element
     mid = 0.5 * (be.start + be.end)
     out: dict[str, tuple[float, str]] = {}
     for key in ("semichord", "a"):
         given = opts.value(key, mid)
+        if given is None and geometry:
+            given = geometry.get(e.eid, {}).get(key)
         if given is None:
             what = "--chord or --semichord" if key == "semichord" else "--elastic-axis"
             raise InputError(
@@ -266,69 +271,14 @@ def element_values(be: BeamElement, opts: ImportOptions) -> dict[str, tuple[floa
     return out
 
 
-def point_masses(
-    deck: Deck, root: int, line: list[BeamElement], up: np.ndarray
-) -> tuple[list[ConcentratedMass], list[str], list[str]]:
-    """Concentrated masses of the CONM2 and CMASS2 cards, their notes, and what is left out."""
-    station = {root: 0.0}
-    frame = {root: line[0]}
-    for be in line:
-        station[be.outboard] = be.end
-        frame[be.outboard] = be
-    span = line[-1].end
-    masses, notes, left = [], [], []
-    for pm in deck.masses:
-        label = f"{pm.card} {pm.eid}"
-        if pm.grid not in station:
-            raise InputError(
-                f"{deck.path}: {label} is on GRID {pm.grid}, which is on no beam element"
-            )
-        be = frame[pm.grid]
-        if pm.grid == root:
-            left.append(f"{label} on the clamped root GRID {root} (it does not move)")
-            continue
-        if pm.card == "CMASS2":
-            if abs(pm.direction @ up) >= math.cos(ORIENTATION_TOLERANCE):
-                masses.append(ConcentratedMass(station[pm.grid], pm.mass, name=label))
-                notes.append(f"{label}: vertical scalar mass at GRID {pm.grid}")
-            elif abs(pm.direction @ up) <= math.sin(ORIENTATION_TOLERANCE):
-                left.append(f"{label} (in-plane: the wing has no in-plane motion)")
-            else:
-                raise InputError(
-                    f"{deck.path}: {label}: its component is oblique to the vertical: only "
-                    "vertical (or in-plane, left out) scalar masses are supported"
-                )
-            continue
-        r = pm.cg - deck.grids[pm.grid]
-        x = station[pm.grid] + float(r @ be.span_dir)
-        if not 0.0 < x <= span * (1 + 1e-12):
-            raise InputError(
-                f"{deck.path}: {label}: its CG lies {float(r @ be.span_dir):g} m along the span "
-                f"from GRID {pm.grid}, at station {x:g} m, outside the wing (0, {span:g}] m"
-            )
-        inertia = float(be.span_dir @ pm.inertia @ be.span_dir)
-        masses.append(
-            ConcentratedMass(
-                min(x, span),
-                pm.mass,
-                offset=float(r @ be.aft),
-                inertia=max(inertia, 0.0),
-                vertical_offset=float(r @ up),
-                name=label,
-            )
-        )
-        shift = f", CG {float(r @ be.span_dir):g} m outboard" if r @ be.span_dir else ""
-        notes.append(f"{label} at GRID {pm.grid}{shift}; inertia = I about the beam axis")
-    return masses, notes, left
-
-
 def segments(
-    line: list[BeamElement], opts: ImportOptions
+    line: list[BeamElement], opts: ImportOptions, geometry: dict | None = None
 ) -> tuple[list[Segment], list[str], list[dict[str, str]]]:
-    """Merge equal consecutive elements into segments: segments, headers, sources per key."""
+    """Merge equal consecutive elements into segments: segments, headers, sources per key
+    (``geometry``: as :func:`element_values`)."""
     groups: list[tuple[list[BeamElement], dict]] = []
     for be in line:
-        vals = element_values(be, opts)
+        vals = element_values(be, opts, geometry)
         if groups and _same(groups[-1][1], vals):
             groups[-1][0].append(be)
         else:

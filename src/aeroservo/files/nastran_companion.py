@@ -106,6 +106,10 @@ def _values(where: str, tbl: Mapping) -> dict[str, float]:
     return out
 
 
+def _text(v) -> str:
+    return "[" + ", ".join(f"{float(x):.6g}" for x in v) + "]"
+
+
 def _unit_vector(where: str, value: object) -> np.ndarray:
     if not isinstance(value, list) or len(value) != 3:
         raise InputError(f"{where} = {value!r}: expected a vector of 3 numbers [basic frame]")
@@ -204,7 +208,7 @@ def import_options(
     opts = ImportOptions(defaults=defaults, sections=tuple(sections), **kw)
     if abs(float(opts.free_stream @ opts.up)) > 1.0 - 1e-6:
         raise InputError(
-            f"free_stream = {list(opts.free_stream)} is along up = {list(opts.up)}: the flow must "
-            "lie in the wing's plane"
+            f"free_stream = {_text(opts.free_stream)} is along up = {_text(opts.up)}: the flow "
+            "must lie in the wing's plane"
         )
     return opts

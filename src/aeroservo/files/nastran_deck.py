@@ -12,18 +12,22 @@ from __future__ import annotations
 import contextlib
 import io
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
-from .nastran_sections import Section, section_of
+from .nastran_aero import AERO_CARDS, AeroDeck, aero_deck, check_aero_references
+from .nastran_masses import MASS_CARDS, PointMass, frame_axes, point_mass
+from .nastran_sections import Section, section_of, tapered
+from .nastran_units import UnitSystem, unit_hint, unit_system
 
 __all__ = ["Deck", "Element", "PointMass", "read_deck", "SUPPORTED", "pynastran_bdf"]
 
 SUPPORTED = (
     "GRID",
+    "GRDSET",
     "CORD2R",
     "CORD1R",
     "CBAR",
@@ -31,16 +35,34 @@ SUPPORTED = (
     "PBAR",
     "PBARL",
     "PBEAM",
+    "PBEAML",
     "MAT1",
-    "CONM2",
-    "CMASS2",
+    *MASS_CARDS,
     "SPC",
     "SPC1",
+    *AERO_CARDS,
 )
-"""Cards mapped to the wing."""
+"""Cards mapped to the wing, its aerodynamic grid and its flutter case."""
 
-IGNORED = ("PARAM", "EIGRL", "EIGR", "SPCADD", "ENDDATA")
-"""Cards accepted and left out (solution control; ``PARAM,WTMASS`` scales the masses)."""
+IGNORED = ("PARAM", "EIGRL", "EIGR", "EIGC", "SPCADD", "MDLPRM", "ENDDATA")
+"""Cards accepted and left out silently (solution control; ``PARAM,WTMASS`` scales the masses,
+``PARAM,LMODES`` sets the doublet lattice's modes)."""
+
+NOTED = (
+    # loads and dynamic excitation
+    "FORCE", "FORCE1", "FORCE2", "MOMENT", "MOMENT1", "MOMENT2", "LOAD", "GRAV", "PLOAD",
+    "PLOAD1", "PLOAD2", "PLOAD4", "DAREA", "DLOAD", "TLOAD1", "TLOAD2", "RLOAD1", "RLOAD2",
+    "FREQ", "FREQ1", "FREQ2", "TSTEP", "TABLED1", "TABLED2", "TABLED3", "TABLED4", "TABDMP1",
+    "TABRND1", "RANDPS", "GUST", "DELAY", "DPHASE", "EPOINT", "USET", "ASET", "ASET1",
+    "OMIT", "OMIT1", "SUPORT", "SUPORT1", "TEMP", "TEMPD",
+    # static aeroelasticity, monitors and output
+    "TRIM", "AESTAT", "AELINK", "AEPARM", "AECOMP", "AECOMPL", "MONPNT1", "MONDSP1", "PLOTEL",
+    "DIVERG", "CSSCHD", "UXVEC",
+    # design optimisation
+    "DESVAR", "DVPREL1", "DVPREL2", "DVCREL1", "DVMREL1", "DRESP1", "DRESP2", "DRESP3",
+    "DCONSTR", "DCONADD", "DOPTPRM", "DEQATN", "DLINK", "DTABLE", "DSCREEN",
+)  # fmt: skip
+"""Load, output and design cards: left out with one note listing them."""
 
 
 @dataclass(frozen=True)
@@ -57,19 +79,6 @@ class Element:
 
 
 @dataclass(frozen=True)
-class PointMass:
-    """A CONM2 (rigid mass with CG and inertia) or a grounded CMASS2 (scalar mass)."""
-
-    card: str
-    eid: int
-    grid: int
-    mass: float  # [kg], WTMASS applied
-    cg: np.ndarray  # CG position [m, basic]
-    inertia: np.ndarray  # 3x3 inertia tensor about the CG [kg m^2, basic]
-    direction: np.ndarray | None = None  # CMASS2: the direction of its component [basic]
-
-
-@dataclass(frozen=True)
 class Deck:
     """What the wing import needs from a deck, in the basic frame."""
 
@@ -80,6 +89,8 @@ class Deck:
     constraints: dict[int, list[tuple[str, np.ndarray]]]  # grid -> [("T"|"R", axis [basic])]
     wtmass: float
     notes: tuple[str, ...]
+    units: UnitSystem
+    aero: AeroDeck | None = None
 
 
 def pynastran_bdf():
@@ -113,14 +124,16 @@ def _first_line(exc: BaseException) -> str:
     return line[:300]
 
 
-def read_deck(path: str | Path) -> Deck:
-    """Read a stick-model deck.
+def read_deck(path: str | Path, units: str | UnitSystem | None = None) -> Deck:
+    """Read a stick-model deck and convert it to SI.
 
     Parameters
     ----------
     path : str or Path
         Nastran bulk data (``.bdf``, ``.dat``, ``.nas``), with or without executive and case
         control (``BEGIN BULK``).
+    units : str, optional
+        The deck's unit system (:data:`~.nastran_units.UNIT_SYSTEMS`; default ``"si"``).
 
     Raises
     ------
@@ -128,6 +141,7 @@ def read_deck(path: str | Path) -> Deck:
         One line: pyNastran missing, an unreadable deck, an unsupported card, a missing
         reference, or a field the import does not model.
     """
+    units = unit_system(units)
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
@@ -144,30 +158,103 @@ def read_deck(path: str | Path) -> Deck:
             model.read_bdf(str(path), punch=punch, xref=False)
     except Exception as exc:  # pyNastran raises many kinds on a malformed deck
         raise InputError(f"{path}: cannot read the deck: {_first_line(exc)}") from None
-    _check_cards(path, model)
+    noted = _check_cards(path, model)
+    _apply_grdset(model)
     _check_references(path, model)
+    check_aero_references(path, model)
     try:
         with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
             model.cross_reference()
     except Exception as exc:
         raise InputError(f"{path}: {_first_line(exc)}") from None
-    return _extract(path, model)
+    deck = _extract(path, model, units)
+    aero = aero_deck(path, model, units)
+    evidence = {
+        f"material {mat.mid}": (deck.wtmass * float(mat.rho), f"MAT1 {mat.mid}", "RHO x WTMASS")
+        for mat in model.materials.values()
+        if getattr(mat, "rho", None)
+    }
+    if aero is not None and aero.rho_ref_deck:
+        evidence = {"air": (aero.rho_ref_deck * aero.density_ratio, *aero.density_card)} | evidence
+    unit_hint(path, units, evidence)
+    notes = list(deck.notes)
+    if noted:
+        notes.append(f"left out (loads, output, design, trim): {noted}")
+    if aero is not None:
+        notes += aero.notes
+    return replace(deck, notes=tuple(notes), aero=aero)
 
 
-def _check_cards(path: Path, model) -> None:
+def _apply_grdset(model) -> None:
+    """GRDSET's CP, CD and PS on every GRID that leaves them blank (or 0)."""
+    gs = getattr(model, "grdset", None)
+    if gs is None:
+        return
+    for grid in model.nodes.values():
+        if not grid.cp and gs.cp:
+            grid.cp = gs.cp
+        if not grid.cd and gs.cd:
+            grid.cd = gs.cd
+        if not grid.ps and gs.ps:
+            grid.ps = str(gs.ps)
+    model.grdset = None
+
+
+_WHY = {
+    ("RBAR", "RBE1", "RBE2", "RBE3", "RROD", "RTRPLT", "RSPLINE", "MPC"): (
+        "rigid elements and multipoint constraints are not modelled (the wing is one beam)"
+    ),
+    ("CQUAD4", "CQUAD8", "CTRIA3", "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CQUAD2",
+     "CTRIA2", "CHEXA1"): "a plate or solid model is not a stick model",
+    ("CELAS1", "CELAS2", "CELAS3", "CELAS4", "CBUSH", "CDAMP1", "CDAMP2", "CVISC", "GENEL"): (
+        "springs, dampers and general elements are not modelled"
+    ),
+    ("CROD", "CONROD", "CTUBE"): "rods carry no bending: a stick model needs CBAR or CBEAM",
+    ("DMI", "DMIG", "DMIJ", "DMIK", "DMIJI", "K2PP", "M2PP", "B2PP"): (
+        "direct matrix input is not read (aeroservo builds its own matrices)"
+    ),
+    ("CAERO2", "CAERO3", "CAERO4", "CAERO5", "PAERO2", "SPLINE3", "SPLINE4", "SPLINE5"): (
+        "only CAERO1 lifting surfaces with SPLINE1/SPLINE2 are read"
+    ),
+}  # fmt: skip
+
+
+def _card_id(model, name: str) -> str:
+    """The id of the first card called ``name`` in the model's dictionaries ('' if none)."""
+    for store in (
+        "rigid_elements", "elements", "properties", "masses", "caeros", "paeros", "splines",
+        "materials", "coords", "mpcs", "loads", "dloads", "dload_entries", "aesurf",
+    ):  # fmt: skip
+        table = getattr(model, store, None) or {}
+        for key, value in sorted(table.items(), key=lambda kv: str(kv[0])):
+            cards = value if isinstance(value, list) else [value]
+            if any(getattr(c, "type", None) == name for c in cards):
+                return f" {key}"
+    return ""
+
+
+def _check_cards(path: Path, model) -> str:
+    """Refuse an unsupported card in one line naming it and its id; the load, output and
+    design cards left out, as text for the note ('' if none)."""
     counts = dict(getattr(model, "card_count", {}))
     for name in getattr(model, "reject_count", {}) or {}:
         counts.setdefault(name, 1)
-    bad = sorted(c for c in counts if c not in SUPPORTED + IGNORED)
+    rank = {c: i for i, names in enumerate(_WHY) for c in names}  # the structure's first
+    bad = sorted(
+        (c for c in counts if c not in SUPPORTED + IGNORED + NOTED),
+        key=lambda c: (rank.get(c, len(_WHY)), c),
+    )
     if bad:
-        n = counts[bad[0]]
-        more = f" (and {', '.join(bad[1:4])}{'...' if len(bad) > 4 else ''})" if bad[1:] else ""
+        name, n = bad[0], counts[bad[0]]
+        why = next((w for names, w in _WHY.items() if name in names), None)
+        more = f"; also {', '.join(bad[1:4])}{'...' if len(bad) > 4 else ''}" if bad[1:] else ""
+        what = why or "this card is not read (docs/nastran.md lists the cards that are)"
         raise InputError(
-            f"{path}: card {bad[0]} ({n} of them){more} is not supported: aeroservo imports a "
-            f"cantilever stick model of {', '.join(SUPPORTED)} (docs/nastran.md)"
+            f"{path}: {name}{_card_id(model, name)} ({n} card{'s' * (n != 1)}): {what}{more}"
         )
     if not model.elements:
         raise InputError(f"{path}: no CBAR or CBEAM element: nothing to import")
+    return ", ".join(f"{c} ({counts[c]})" for c in sorted(counts) if c in NOTED)
 
 
 def _check_references(path: Path, model) -> None:
@@ -189,7 +276,7 @@ def _check_references(path: Path, model) -> None:
         if elem.pid not in model.properties:
             raise InputError(f"{path}: {elem.type} {eid}: property {elem.pid} is missing")
         prop = model.properties[elem.pid]
-        if prop.type not in ("PBAR", "PBARL", "PBEAM"):
+        if prop.type not in ("PBAR", "PBARL", "PBEAM", "PBEAML"):
             raise InputError(
                 f"{path}: {elem.type} {eid}: property {prop.type} {prop.pid} is not supported"
             )
@@ -206,23 +293,24 @@ def _check_references(path: Path, model) -> None:
             raise InputError(f"{path}: CONM2 {eid}: CID = {cid}: no such coordinate system")
 
 
-def _axes(coord) -> np.ndarray:
-    """Rows: the frame's unit axes in the basic frame."""
-    if coord is None or coord.cid == 0:
-        return np.eye(3)
-    return np.array([coord.i, coord.j, coord.k], dtype=float)
+def vector_text(v) -> str:
+    """A vector as ``[0, 0.5, 1]`` for messages (no numpy reprs)."""
+    return "[" + ", ".join(f"{float(x):.6g}" for x in np.ravel(v)) + "]"
 
 
-def _extract(path: Path, model) -> Deck:
+def _extract(path: Path, model, units: UnitSystem) -> Deck:
     notes = []
     wtmass = 1.0
     param = model.params.get("WTMASS")
     if param is not None:
         wtmass = float(param.values[0])
         notes.append(f"PARAM,WTMASS,{wtmass:g} scales every mass and inertia")
-    grids = {nid: np.asarray(g.get_position(), dtype=float) for nid, g in model.nodes.items()}
-    cd_axes = {nid: _axes(model.coords[g.cd or 0]) for nid, g in model.nodes.items()}
-    elements = []
+    grids = {
+        nid: np.asarray(g.get_position(), dtype=float) * units.length
+        for nid, g in model.nodes.items()
+    }
+    cd_axes = {nid: frame_axes(model.coords[g.cd or 0]) for nid, g in model.nodes.items()}
+    elements, taper = [], []
     for eid, elem in sorted(model.elements.items()):
         where = f"{path}: {elem.type} {eid}"
         if elem.type not in ("CBAR", "CBEAM"):
@@ -237,12 +325,14 @@ def _extract(path: Path, model) -> Deck:
             w = getattr(elem, key, None)
             if w is not None and np.any(np.abs(np.asarray(w, dtype=float)) > 0.0):
                 raise InputError(
-                    f"{where}: offset {key.upper()} = {list(np.asarray(w, float))}: element "
+                    f"{where}: offset {key.upper()} = {vector_text(w)}: element "
                     "offsets are not modelled; put the grids on the elastic axis"
                 )
         if elem.type == "CBEAM" and (getattr(elem, "sa", 0) or getattr(elem, "sb", 0)):
             raise InputError(f"{where}: warping scalar points SA/SB are not modelled")
         offt = getattr(elem, "offt", None) or "GGG"
+        if not isinstance(offt, str):  # field 9 as the flag of older decks (1: X1-X3 a vector)
+            offt = "GGG"
         if getattr(elem, "bit", None) is not None:
             raise InputError(f"{where}: BIT field (curved beam) is not supported; use OFFT")
         ga, gb = elem.node_ids[:2]
@@ -259,9 +349,19 @@ def _extract(path: Path, model) -> Deck:
         mat = model.materials[model.properties[elem.pid].mid]
         if mat.type != "MAT1":
             raise InputError(f"{where}: material {mat.type} {mat.mid}: only MAT1 is supported")
-        section = section_of(path, model.properties[elem.pid], mat, wtmass)
+        prop = model.properties[elem.pid]
+        section = section_of(path, prop, mat, wtmass, units)
+        if prop.type in ("PBEAM", "PBEAML") and tapered(prop) and prop.pid not in taper:
+            taper.append(prop.pid)
         elements.append(Element(elem.type, eid, ga, gb, v, g0, section))
-    masses = [_point_mass(path, m, model, cd_axes, wtmass) for _, m in sorted(model.masses.items())]
+    if taper:
+        notes.append(
+            f"tapered PBEAM/PBEAML {', '.join(map(str, taper))}: each element takes its section "
+            "at mid-length (linear between the stations)"
+        )
+    masses = [
+        point_mass(path, m, model, cd_axes, wtmass, units) for _, m in sorted(model.masses.items())
+    ]
     constraints: dict[int, list] = {}
 
     def constrain(nid: int, comps: str, where: str) -> None:
@@ -291,51 +391,6 @@ def _extract(path: Path, model) -> Deck:
                             "is not modelled (a clamp is zero)"
                         )
                     constrain(nid, comps, f"SPC {sid}")
-    return Deck(path, grids, tuple(elements), tuple(masses), constraints, wtmass, tuple(notes))
-
-
-def _point_mass(path: Path, card, model, cd_axes: dict, wtmass: float) -> PointMass:
-    where = f"{path}: {card.type} {card.eid}"
-    if card.type == "CONM2":
-        nid = card.nid
-        x = np.asarray(card.X, dtype=float)
-        i11, i21, i22, i31, i32, i33 = (float(v) for v in card.I)
-        local = np.array([[i11, -i21, -i31], [-i21, i22, -i32], [-i31, -i32, i33]])
-        cid = card.cid if card.cid is not None else 0
-        if cid == -1:  # X is the CG in the basic frame, the inertia in the basic frame
-            cg, axes = x, np.eye(3)
-        else:
-            axes = _axes(model.coords[cid]) if cid else np.eye(3)
-            cg = np.asarray(model.nodes[nid].get_position(), dtype=float) + axes.T @ x
-        inertia = axes.T @ local @ axes
-        if np.linalg.eigvalsh(0.5 * (inertia + inertia.T)).min() < -1e-12 * max(
-            1e-300, np.abs(inertia).max()
-        ):
-            raise InputError(f"{where}: its inertia matrix is not positive semi-definite")
-        return PointMass("CONM2", card.eid, nid, wtmass * float(card.mass), cg, wtmass * inertia)
-    if card.type == "CMASS2":
-        nids = [n for n in card.node_ids if n]
-        comps = [c for c in (card.c1, card.c2) if c]
-        if len(nids) != 1 or len(comps) != 1:
-            raise InputError(
-                f"{where}: a scalar mass between two grids (or without a component) is not "
-                "supported; give one grid and one component"
-            )
-        comp = int(comps[0])
-        if comp > 3:
-            raise InputError(
-                f"{where}: component {comp} is a rotation: a rotational scalar mass is not "
-                "supported (give the inertia on a CONM2)"
-            )
-        nid = nids[0]
-        pos = np.asarray(model.nodes[nid].get_position(), dtype=float)
-        return PointMass(
-            "CMASS2",
-            card.eid,
-            nid,
-            wtmass * float(card.mass),
-            pos,
-            np.zeros((3, 3)),
-            direction=cd_axes[nid][comp - 1],
-        )
-    raise InputError(f"{where}: mass card not supported (CONM2, CMASS2)")
+    return Deck(
+        path, grids, tuple(elements), tuple(masses), constraints, wtmass, tuple(notes), units
+    )

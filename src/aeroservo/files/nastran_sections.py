@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .nastran_units import UnitSystem
 
-__all__ = ["Section", "section_of", "pbarl_section", "PBARL_TYPES"]
+__all__ = ["Section", "section_of", "pbarl_section", "tapered", "PBARL_TYPES"]
 
 PBARL_TYPES = ("BAR", "ROD", "TUBE", "BOX")
 """PBARL cross-section types whose area, moments and torsion constant are computed here."""
@@ -82,50 +83,63 @@ def pbarl_section(kind: str, dim: list[float]) -> tuple[float, float, float, flo
     raise ValueError(f"TYPE = {kind!r} is not supported ({', '.join(PBARL_TYPES)} are)")
 
 
-def _constant(where: str, name: str, values) -> float:
-    """One value of a PBEAM field that must not vary along the element."""
+def _mid(prop, values) -> float:
+    """A PBEAM/PBEAML value at mid-length: linear between its stations (XXB)."""
     arr = np.atleast_1d(np.asarray(values, dtype=float))
-    if arr.size and not np.allclose(arr, arr[0], rtol=1e-12, atol=0.0):
-        raise InputError(
-            f"{where}: {name} varies along the element ({list(arr)}): tapered beams are not "
-            "supported; split the element or give one section"
-        )
-    return float(arr[0]) if arr.size else 0.0
+    xxb = np.atleast_1d(np.asarray(getattr(prop, "xxb", [0.0]), dtype=float))
+    if arr.size < 2 or xxb.size != arr.size:
+        return float(arr[0]) if arr.size else 0.0
+    order = np.argsort(xxb)
+    return float(np.interp(0.5, xxb[order], arr[order]))
 
 
-def section_of(path: Path, prop, mat, wtmass: float) -> Section:
-    """The :class:`Section` of a pyNastran property card and its MAT1."""
+def tapered(prop) -> bool:
+    """Whether a PBEAM/PBEAML's section varies along the element."""
+    for key in ("A", "i1", "i2", "j", "dim"):
+        arr = getattr(prop, key, None)
+        if arr is not None and len(arr) > 1:
+            arr = np.asarray(arr, dtype=float)
+            if not np.allclose(arr, arr[0], rtol=1e-12, atol=0.0):
+                return True
+    return False
+
+
+def section_of(path: Path, prop, mat, wtmass: float, units: UnitSystem) -> Section:
+    """The :class:`Section` of a pyNastran property card and its MAT1, in SI.
+
+    A PBEAM or PBEAML with stations (a tapered element) gives its values at mid-length, linear
+    between the stations (the element's stiffness and mass to second order in its length).
+    """
     where = f"{path}: {prop.type} {prop.pid}"
     label = f"{prop.type} {prop.pid}, MAT1 {mat.mid}"
-    E, G = float(mat.e or 0.0), float(mat.g or 0.0)
+    E, G = float(mat.e or 0.0) * units.stress, float(mat.g or 0.0) * units.stress
     if not E > 0.0 or not G > 0.0:
         raise InputError(f"{path}: MAT1 {mat.mid}: E = {E:g}, G = {G:g}: both must be > 0 [Pa]")
-    rho = wtmass * float(mat.rho or 0.0)
-    if prop.type == "PBAR":
-        if float(prop.i12 or 0.0) != 0.0:
+    rho = wtmass * float(mat.rho or 0.0) * units.density
+    L, m_len = units.length, wtmass * units.mass / units.length  # NSM [mass/length]
+    if prop.type in ("PBAR", "PBEAM"):
+        vals = {k: _mid(prop, getattr(prop, k)) for k in ("A", "i1", "i2", "i12", "j")}
+        if vals["i12"] != 0.0:
             raise InputError(
-                f"{where}: I12 = {prop.i12:g}: a section whose principal axes are not the "
+                f"{where}: I12 = {vals['i12']:g}: a section whose principal axes are not the "
                 "element's couples flapwise and in-plane bending, which is not modelled"
             )
-        vals = (float(prop.A), float(prop.i1), float(prop.i2), float(prop.j))
-        nsm = wtmass * float(prop.nsm or 0.0)
-        sec = Section(label, prop.pid, E, G, rho, *vals, nsm)
-    elif prop.type == "PBARL":
+    if prop.type == "PBAR":
+        vals = (vals["A"] * L**2, vals["i1"] * L**4, vals["i2"] * L**4, vals["j"] * L**4)
+        sec = Section(label, prop.pid, E, G, rho, *vals, m_len * float(prop.nsm or 0.0))
+    elif prop.type in ("PBARL", "PBEAML"):
         kind = getattr(prop, "beam_type", None) or getattr(prop, "Type", None)
+        dims = prop.dim if prop.type == "PBARL" else np.asarray(prop.dim, dtype=float)
+        if prop.type == "PBEAML":
+            dims = [_mid(prop, dims[:, k]) for k in range(dims.shape[1])]
         try:
-            vals = pbarl_section(str(kind), list(prop.dim))
+            a_, i1, i2, j_ = pbarl_section(str(kind), list(dims))
         except ValueError as exc:
             raise InputError(f"{where}: {exc}; or give A, I1, I2, J on a PBAR") from None
-        nsm = wtmass * float(prop.nsm or 0.0)
-        sec = Section(f"{label} ({kind})", prop.pid, E, G, rho, *vals, nsm)
+        nsm = _mid(prop, prop.nsm) if prop.type == "PBEAML" else float(prop.nsm or 0.0)
+        vals = (a_ * L**2, i1 * L**4, i2 * L**4, j_ * L**4)
+        sec = Section(f"{label} ({kind})", prop.pid, E, G, rho, *vals, m_len * nsm)
     elif prop.type == "PBEAM":
-        c = {k: _constant(where, k, getattr(prop, k)) for k in ("A", "i1", "i2", "i12", "j")}
-        c["nsm"] = _constant(where, "NSM", getattr(prop, "nsm", [0.0]))
-        if c["i12"] != 0.0:
-            raise InputError(
-                f"{where}: I12 = {c['i12']:g}: a section whose principal axes are not the "
-                "element's couples flapwise and in-plane bending, which is not modelled"
-            )
         for key in ("n1a", "n2a", "n1b", "n2b"):
             if float(getattr(prop, key, 0.0) or 0.0) != 0.0:
                 raise InputError(
@@ -136,25 +150,25 @@ def section_of(path: Path, prop, mat, wtmass: float) -> Section:
         for key in ("m1", "m2", "nsi"):
             a_ = float(getattr(prop, key + "a", 0.0) or 0.0)
             b_ = getattr(prop, key + "b", None)
-            ends[key] = _constant(where, key.upper(), [a_, a_ if b_ is None else float(b_)])
+            ends[key] = 0.5 * (a_ + (a_ if b_ is None else float(b_)))
         sec = Section(
             label,
             prop.pid,
             E,
             G,
             rho,
-            c["A"],
-            c["i1"],
-            c["i2"],
-            c["j"],
-            wtmass * c["nsm"],
-            nsi=wtmass * ends["nsi"],
-            m1=ends["m1"],
-            m2=ends["m2"],
+            vals["A"] * L**2,
+            vals["i1"] * L**4,
+            vals["i2"] * L**4,
+            vals["j"] * L**4,
+            m_len * _mid(prop, getattr(prop, "nsm", [0.0])),
+            nsi=m_len * L**2 * ends["nsi"],
+            m1=ends["m1"] * L,
+            m2=ends["m2"] * L,
             gives_inertia=True,
         )
     else:
-        raise InputError(f"{where}: property type not supported (PBAR, PBARL, PBEAM)")
+        raise InputError(f"{where}: property type not supported (PBAR, PBARL, PBEAM, PBEAML)")
     for name in ("A", "I1", "I2", "J"):
         value = getattr(sec, name)
         if not (math.isfinite(value) and value >= 0.0):

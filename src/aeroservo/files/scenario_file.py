@@ -29,6 +29,7 @@ from .scenario_tables import (
     engaged_speeds,
     flight,
     is_file,
+    sol145_table,
     trade_table,
 )
 from .toml_tables import Table, check_integers, is_scenario_file, one_line_errors, read_toml
@@ -52,10 +53,11 @@ TOP = (
     "gust_loads",
     "lco",
     "section",
+    "sol145",
 )
 USED = {
-    "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping"),
-    "simulate": TOP[:-4],
+    "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping", "sol145"),
+    "simulate": TOP[: TOP.index("trade")],
     "trade": (
         "scenario",
         "wing",
@@ -233,6 +235,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     kw["gust_model"] = md.string("gust", "kussner", choices=("kussner", "upwash"))
     kw["v_max"] = md.number("v_max", quantity="flight_speed")
     kw["pk"] = md.boolean("pk", False)
+    kw["sol145"] = sol145_table(top.table("sol145"), kw["v_max"])
 
     sg = top.table("signals").check_keys(
         (), ("controls", "sensors", "outputs", "sensor_filter", "filter_order")

@@ -207,3 +207,29 @@ def controller(ct: Table, path: Path, key: str = "spec") -> ControllerSpec:
         return load_controller(path)
     except InputError as exc:
         raise InputError(f"{ct.file}: {ct.key_name(key)} -> {exc}") from None
+
+
+def sol145_table(tbl: Table, v_max: float | None) -> dict | None:
+    """A flutter scenario's ``[sol145]`` table (the flutter case of an imported Nastran deck,
+    ``docs/nastran.md``): the p-k at its velocities, printed as Nastran's flutter summary."""
+    if not tbl.data:
+        return None
+    tbl.check_keys(
+        (),
+        ("method", "velocities", "reference_chord", "density_ratio", "velocity_unit")
+        + ("velocity_factor",),
+    )
+    velocities = tbl.numbers("velocities", None, quantity="flight_speed", increasing=True)
+    if velocities is not None and v_max is not None and max(velocities) > v_max:
+        tbl.fail("velocities", velocities, f"the highest exceeds model.v_max = {v_max:g} m/s")
+    chord = tbl.number("reference_chord", None, unit="m", lo=0.0, hi=2e3, lo_open=True)
+    if velocities is not None and chord is None:
+        raise InputError(f"{tbl.file}: sol145.reference_chord: missing (KFREQ needs it) [m]")
+    return {
+        "method": tbl.string("method", "PK"),
+        "velocities": velocities,
+        "reference_chord": chord,
+        "density_ratio": tbl.number("density_ratio", 1.0, lo=0.0, hi=1e3, lo_open=True),
+        "velocity_unit": tbl.string("velocity_unit", ""),
+        "velocity_factor": tbl.number("velocity_factor", 1.0, lo=0.0, hi=1e3, lo_open=True),
+    }

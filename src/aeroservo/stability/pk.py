@@ -72,6 +72,7 @@ def pk_flutter(
     rtol: float = 1e-7,
     mach: float = 0.0,
     boundary: FlutterResult | None = None,
+    speeds: object = None,
 ) -> FlutterResult:
     """Flutter boundary by the p-k method with the exact Theodorsen function.
 
@@ -102,6 +103,9 @@ def pk_flutter(
         the p-k follows the modes of its modal model and is restarted at each of its onsets
         (the p-k crossing next to it is added if the branch tracking missed it, with a
         warning), so that no p-k root below the reported flutter speed crosses unseen.
+    speeds : sequence of float, optional
+        Speeds [m/s] the branches must pass through (added to the uniform grid; at most
+        ``v_max``): the velocities of a Nastran flutter case (``stability/sol145.py``).
 
     Returns
     -------
@@ -134,7 +138,12 @@ def pk_flutter(
     if v_max is None:
         v_max = default_v_max(b_ref, float(abs(p0[min(1, n_modes - 1)])), v_divs)
     v_max = check_quantity("v_max", v_max, "flight_speed")
-    speeds = np.linspace(0.0, v_max, n_speeds)
+    grid = np.linspace(0.0, v_max, n_speeds)
+    if speeds is not None:
+        extra = [check_number("speeds", v, unit="m/s", lo=0.0, hi=v_max) for v in speeds]
+        grid = np.unique(np.concatenate([grid, extra]))
+    speeds = grid
+    n_speeds = speeds.size
     P, Q, ended = track(pk, speeds, p0, phi.astype(complex), PKConvergenceError)
 
     crossings = []

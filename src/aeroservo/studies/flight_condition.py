@@ -109,3 +109,30 @@ def aero_text(model, mach: float, source: str = "default") -> str:
         return f"aerodynamics: strip theory, Wagner '{model.wagner.name}', {comp} ({how})"
     boxes = model.dlm.grid.n_boxes
     return f"aerodynamics: {model.aero.describe()}; {boxes} boxes; Mach {mach:.4g} ({how})"
+
+
+def sol145_at_condition(cond: tuple, boundary, sol145: dict):
+    """The p-k at a Nastran flutter case's velocities (a scenario's ``[sol145]`` table) and its
+    flutter summary (:class:`aeroservo.stability.sol145.Sol145Summary`).
+
+    ``cond`` is ``(model, density, atmosphere, compressibility, mach)`` as for
+    :func:`flutter_at_condition`; ``boundary`` the time-domain result there (its speed range
+    and modal model). Returns ``(pk, summary)``.
+    """
+    from ..stability.pk import pk_flutter
+    from ..stability.sol145 import sol145_summary
+
+    velocities = sol145["velocities"]
+    v_max = max(boundary.v_max, max(velocities))
+    kw = {"boundary": boundary} if cond[2] is None else {}
+    pk = flutter_at_condition(*cond, solver=pk_flutter, v_max=v_max, speeds=velocities, **kw)
+    summary = sol145_summary(
+        pk,
+        velocities,
+        sol145["reference_chord"],
+        method=sol145["method"],
+        density_ratio=sol145["density_ratio"],
+        velocity_unit=sol145["velocity_unit"],
+        velocity_factor=sol145["velocity_factor"],
+    )
+    return pk, summary

@@ -118,11 +118,18 @@ def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
         **aero_record(model, fr.mach, mach_source(scenario.compressibility, scenario.mach, atm)),
     }
     summary.update({k: v for k, v in fr.to_dict().items() if k not in summary})
-    if scenario.pk:
+    sol145 = scenario.sol145
+    if sol145 is not None and sol145["velocities"]:
+        from .flight_condition import sol145_at_condition
+
+        pk, table = sol145_at_condition(cond, fr, sol145)
+        summary["sol145"] = table.to_dict()
+    elif scenario.pk:
         from ..stability.pk import pk_flutter
 
         kw = {"boundary": fr} if atm is None else {}
         pk = flutter_at_condition(*cond, solver=pk_flutter, v_max=fr.v_max, **kw)
+    if scenario.pk or "sol145" in summary:
         summary["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
             "flutter_speed": pk.flutter_speed,
             "flutter_frequency": pk.flutter_frequency,

@@ -76,6 +76,7 @@ class Scenario:
     gust_model: str = "kussner"
     v_max: float | None = None
     pk: bool = False
+    sol145: dict | None = None  # a Nastran flutter case's velocities (files/scenario_tables)
     controls: tuple = ()
     sensors: tuple = ()
     outputs: tuple = ()
