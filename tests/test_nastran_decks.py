@@ -409,7 +409,7 @@ def test_out_naming_the_deck_is_refused(tmp_path):
     deck = tmp_path / "d.bdf"
     deck.write_bytes(SAMPLE.read_bytes())
     run = _cli("import", "nastran", "d.bdf", "--units", "in-lbf-s", "--out", "d.bdf", cwd=tmp_path)
-    assert run.returncode == 2 and "the deck itself" in run.stderr
+    assert run.returncode == 2 and "that is the deck" in run.stderr
     assert deck.read_bytes() == SAMPLE.read_bytes()
 
 
@@ -505,3 +505,139 @@ def test_cli_unit_names_are_the_unit_systems():
     from aeroservo.files.nastran_units import UNIT_SYSTEMS
 
     assert tuple(UNIT_NAMES) == tuple(UNIT_SYSTEMS)
+
+
+def test_deck_files_as_they_come(tmp_path):
+    """A Latin-1 byte in a comment reads; a missing INCLUDE is one line and leaves no
+    pyNastran_crash.bdf; a FIFO is refused without waiting (issue 40's Nastran items)."""
+    lat = tmp_path / "lat.bdf"
+    lat.write_bytes(b"$ caf\xe9 \xb0 (Latin-1)\n" + SAMPLE.read_bytes())
+    assert read_nastran(lat, units="in-lbf-s").wing.span == pytest.approx(5.72 * IN)
+    inc = tmp_path / "inc.bdf"
+    inc.write_text("INCLUDE 'missing.inc'\nGRID,1,,0.,0.,0.\n")
+    run = _cli("import", "nastran", "inc.bdf", "--out", "w.toml", cwd=tmp_path)
+    assert run.returncode == 2 and run.stderr.count("\n") == 1 and "missing.inc" in run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["inc.bdf", "lat.bdf"]
+    import os
+
+    os.mkfifo(tmp_path / "fifo")
+    with pytest.raises(InputError, match="not a regular file"):
+        read_nastran(tmp_path / "fifo")
+
+
+# ---------------------------------------------------------------------------------------------
+# the sample deck edited (review findings)
+# ---------------------------------------------------------------------------------------------
+
+CAERO = (
+    "CAERO1  101     1       1       6       4                       1       +CA101  \n"
+    "+CA101  -1.     -.26795 0.0     2.0706  -1.     5.45205 0.0     2.0706          \n"
+)
+SPLINE = (
+    "SPLINE2 100     101     101     124     100     0.0     1.      1       +SP     \n"
+    "+SP     0.0     0.0" + " " * 61 + "\n"
+)
+
+
+def _edited(tmp_path, name, old, new, extra="", old2=None, new2=None):
+    text = SAMPLE.read_text()  # universal newlines: the deck's CRLF read as LF
+    for a, b in ((old, new), (old2, new2)):
+        if a is not None:
+            assert a in text, a
+            text = text.replace(a, b)
+    path = tmp_path / name
+    path.write_text(text.replace("ENDDATA", extra + "ENDDATA"))
+    return path
+
+
+def _sp(eid, caero, b1, b2):
+    return f"SPLINE2,{eid},{caero},{b1},{b2},100,0.0,1.,1\n,0.0,0.0\n"
+
+
+def test_panels_in_basic_side_by_side_and_stacked(tmp_path):
+    """The sample's panel written in the basic frame, split in two side by side (NSPAN 3 + 3)
+    or stacked (NCHORD 3 + 1, 70 % and 30 % of the chord): one segment each time (the deck's
+    7-digit fields no longer split it), the same 4 x 6 boxes, and a scenario that runs (the
+    review found 10 segments and a scenario refused for the basic-frame panel)."""
+    basic = "CAERO1,101,1,,6,4,,,1\n,-1.035276,0.,0.,2.0706,0.445168,5.525095,0.,2.0706\n"
+    side = (
+        "CAERO1,101,1,1,3,4,,,1\n,-1.,-.26795,0.,2.0706,-1.,2.59205,0.,2.0706\n"
+        "CAERO1,201,1,1,3,4,,,1\n,-1.,2.59205,0.,2.0706,-1.,5.45205,0.,2.0706\n"
+    )
+    stacked = (  # in the basic frame: the aft panel's leading edge 1.44942 in downstream
+        "CAERO1,101,1,,6,3,,,1\n,-1.035276,0.,0.,1.44942,0.445168,5.525095,0.,1.44942\n"
+        "CAERO1,301,1,,6,1,,,1\n,.414144,0.,0.,.62118,1.894588,5.525095,0.,.62118\n"
+    )
+    cases = {
+        "basic": (basic, SPLINE, ""),
+        "side": (side, _sp(100, 101, 101, 112), _sp(200, 201, 201, 212)),
+        "stacked": (stacked, _sp(100, 101, 101, 118), _sp(300, 301, 301, 306)),
+    }
+    for name, (caero, spline, extra) in cases.items():
+        path = _edited(tmp_path, f"{name}.bdf", CAERO, caero, extra, SPLINE, spline)
+        result = read_nastran(path, units="in-lbf-s")
+        (seg,) = result.wing.segments
+        assert abs(seg.a) < 1e-4 and "chordwise = 4" in result.text, name
+        assert "spanwise = 6" in result.text, name
+    run = _cli(
+        "import", "nastran", "basic.bdf", "--units", "in-lbf-s", "--out", "b.toml", cwd=tmp_path
+    )
+    assert run.returncode == 0, run.stderr
+    flutter = _cli("flutter", "b_flutter.toml", "--json", cwd=tmp_path)
+    assert flutter.returncode == 0, flutter.stderr
+
+
+@pytest.mark.parametrize(
+    "old,new,extra,match",
+    [
+        ("FLUTTER 30      PK", "FLUTTER 30      PK", "FLUTTER,40,PK,1,2,4\n", 30),
+        (" FMETHOD = 30", "$ no FMETHOD", "FLUTTER,20,PK,1,2,4\n", 20),
+        ("FMETHOD = 30", "FMETHOD = 77", "", "FMETHOD = 77: no FLUTTER 77"),
+        ("AERO    0       1.3+4   2.0706  1.145-7", "AEROS   0               2.0706  20.     100.", "", "no AERO card"),
+        ("FLFACT  2       .45", "FLFACT  2       1.2", "", r"Mach 1.2 \(FLFACT 2\)"),
+        ("SET1    100     1       THRU    11", "SET1,100,1,2,3,99", "", "SET1 100: GRID 99 is missing"),
+        ("CMASS2  21      1.4-6   11      5", "CMASS1,21,7,11,5", "", "CMASS1 21: PMASS 7 is missing"),
+        ("CMASS2  21      1.4-6   11      5", "CMASS2,21,1.4-6,11,7", "", "component 7: expected 1 to 6"),
+        ("CBAR    10      1       10      11      0.0     0.0     1.      1", "CBAR,10,1,10,11,0.,0.,1.,2", "", "field 9 = 2"),
+    ],
+)  # fmt: skip
+def test_edited_sample_cases(tmp_path, old, new, extra, match):
+    """Two FLUTTER cards: the case control's FMETHOD = 30 selects, without it the lowest id
+    (noted); a missing FMETHOD target, AEROS without AERO, a Mach number out of range, a SET1
+    or PMASS that is missing, a component 7 and the field-9 flag 2 with a vector are each one
+    line naming the card."""
+    path = _edited(tmp_path, "e.bdf", old, new, extra)
+    if isinstance(match, int):
+        result = read_nastran(path, units="in-lbf-s")
+        assert result.aero.flutter.sid == match
+        assert ("no FMETHOD: FLUTTER 20" in result.text) == (match == 20)
+        return
+    with pytest.raises(InputError, match=match) as info:
+        read_nastran(path, units="in-lbf-s")
+    assert "\n" not in str(info.value) and str(path) in str(info.value)
+
+
+def test_outputs_never_overwrite_inputs(tmp_path):
+    """--out naming the companion table, or a scenario path naming it, is refused."""
+    deck = tmp_path / "d.bdf"
+    deck.write_bytes(SAMPLE.read_bytes())
+    comp = tmp_path / "c_flutter.toml"
+    comp.write_text('name = "x"\n')
+    for out in ("c_flutter.toml", "c.toml"):
+        args = ("import", "nastran", "d.bdf", "--units", "in-lbf-s", "--companion", comp.name)
+        run = _cli(*args, "--out", out, cwd=tmp_path)
+        assert run.returncode == 2 and "that is the companion table" in run.stderr, run.stderr
+        assert comp.read_text() == 'name = "x"\n'
+
+
+def test_pbeam_three_stations_average(tmp_path):
+    """A PBEAM with A = 0.03, 0.01, 0.02 at XXB = 0, 0.5, 1 takes the element average of the
+    linear interpolation, (0.03 + 2 x 0.01 + 0.02) / 4 = 0.0175 m^2 (the review found the
+    mid-length value, 11 % off for such a section)."""
+
+    def pbeam(m):
+        m.add_pbeam(1, 1, [0.0, 0.5, 1.0], ["YES"] * 3, [0.03, 0.01, 0.02], [1e-5] * 3,
+                    [2e-5] * 3, [0.0] * 3, [3e-5] * 3)  # fmt: skip
+
+    seg = _read(tmp_path, _beam(pbeam=pbeam)).wing.segments[0]
+    assert seg.mass == pytest.approx(2700.0 * 0.0175, rel=1e-12)

@@ -20,6 +20,7 @@ from ..structure.wing import Wing
 from .nastran_beam import beam_line, segments
 from .nastran_case import (
     analysis_tables,
+    box_counts,
     case_v_max,
     panel_geometry,
     scenario_text,
@@ -145,12 +146,14 @@ def read_nastran(
     tables, scenario = "", None
     if aero is not None:
         v_max = case_v_max(aero, _frequencies(wing, len(line), aero))
+        pieces = len(wing.segments) + 2 * len(wing.control_surfaces)
+        boxes = box_counts(aero, opts.up, pieces, notes) if aero.panels else (0, 0)
         try:
-            tables = analysis_tables(aero, len(line), notes, v_max)
+            tables = analysis_tables(aero, len(line), boxes, v_max)
         except InputError as exc:
             raise InputError(f"{path}: {exc}") from None
         notes += _surface_notes(aero, surface_geo, surfaces)
-        args = (str(wing_file), wing.name, path, data.units, len(line), v_max)
+        args = (str(wing_file), wing.name, path, data.units, len(line), boxes, v_max)
         scenario = scenario_text(aero, *args)
     text = _commented(wing, path, opts, headers, sources, mass_notes, notes, left) + (
         f"\n{tables}" if tables else ""
@@ -187,11 +190,12 @@ def write_nastran_wing(deck: str | Path, out: str | Path, **options) -> NastranI
     from ..atomic import atomic_write_set, check_output_path
 
     check_output_path(out, "--out")
-    if Path(out).resolve() == Path(deck).resolve():
-        raise InputError(f"--out = {out}: that is the deck itself; name another file")
+    inputs = {"the deck": deck, "the companion table": options.get("companion")}
+    _not_an_input("--out", out, inputs)
     result = read_nastran(deck, wing_file=Path(out).name, **options)
     files = [(Path(out), result.text)]
     if result.scenario is not None:
+        _not_an_input("the flutter scenario", scenario_path(out), inputs)
         files.append((scenario_path(out), result.scenario))
     atomic_write_set([(p, lambda q, t=t: q.write_text(t, encoding="utf-8")) for p, t in files])
     return result
@@ -206,6 +210,13 @@ def _frequencies(wing: Wing, n_elements: int, aero) -> list[float]:
     model = AeroelasticModel(wing, max(n_elements, 2) if n_elements <= 300 else 300)
     n = min(aero.lmodes or 3, model.n_dofs)
     return list(model.natural_modes(n).frequencies)
+
+
+def _not_an_input(what: str, out: Path | str, inputs: dict) -> None:
+    """Refuse an output that would overwrite an input file."""
+    for name, path in inputs.items():
+        if path is not None and Path(out).resolve() == Path(path).resolve():
+            raise InputError(f"{what} = {out}: that is {name}; name another file")
 
 
 def _given_flow(opts) -> bool:

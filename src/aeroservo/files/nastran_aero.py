@@ -106,20 +106,27 @@ def _flfact(path: Path, model, sid: int | None, what: str, card: str) -> tuple[f
 
 
 def _selected_flutter(path: Path, model, notes: list) -> object | None:
+    """The FLUTTER card case control's FMETHOD names, or the only (else the lowest) one."""
     if not model.flutters:
         return None
     sids = sorted(model.flutters)
     chosen = None
     ccd = getattr(model, "case_control_deck", None)
-    if ccd is not None and len(sids) > 1:
-        for sub in ccd.subcases.values():
-            if sub.has_parameter("FMETHOD"):
-                chosen = int(sub.get_parameter("FMETHOD")[0])
-                break
-    if chosen not in model.flutters:
+    for sub in ccd.subcases.values() if ccd is not None else ():
+        try:
+            chosen = int(sub.get_parameter("FMETHOD")[0])
+            break
+        except (KeyError, ValueError, TypeError, IndexError):
+            continue
+    if chosen is not None and chosen not in model.flutters:
+        raise InputError(
+            f"{path}: case control FMETHOD = {chosen}: no FLUTTER {chosen} (the deck has "
+            f"FLUTTER {', '.join(map(str, sids))})"
+        )
+    if chosen is None:
         chosen = sids[0]
-    if len(sids) > 1:
-        notes.append(f"FLUTTER {chosen} is the flutter case; FLUTTER {sids} are in the deck")
+        if len(sids) > 1:
+            notes.append(f"no FMETHOD: FLUTTER {chosen} is the flutter case of FLUTTER {sids}")
     return model.flutters[chosen]
 
 
@@ -132,8 +139,15 @@ def _flutter_case(path: Path, model, units: UnitSystem, notes: list) -> FlutterC
     dens = _flfact(path, model, card.density, "density ratios", where)
     machs = _flfact(path, model, card.mach, "Mach numbers", where)
     third = _flfact(path, model, card.reduced_freq_velocity, "velocities", where)
+    # a negative velocity asks Nastran to print the mode shape: its magnitude is the speed
     vel = tuple(abs(v) * units.length for v in third) if method in PK_METHODS else ()
     ks = () if method in PK_METHODS else third
+    for m in machs:
+        if not 0.0 <= m < 1.0:
+            raise InputError(
+                f"{path}: {where}: Mach {m:g} (FLFACT {card.mach}): aeroservo's flutter "
+                "analysis takes Mach numbers in [0, 1)"
+            )
     ids = ", ".join(str(x) for x in (card.density, card.mach, card.reduced_freq_velocity))
     return FlutterCase(
         card.sid, method, dens, machs, vel, ks, str(card.imethod or "L"),
@@ -203,8 +217,16 @@ def _surfaces(path: Path, model, panels) -> tuple:
         if lst is None:
             raise InputError(f"{where}: AELIST {surf.alid1} is missing")
         boxes = tuple(int(b) for b in lst.elements)
-        if not any(p.box(b) for p in panels for b in boxes):
-            raise InputError(f"{where}: AELIST {surf.alid1} lists no box of a CAERO1")
+        stray = [b for b in boxes if not any(p.box(b) is not None for p in panels)]
+        if stray:
+            raise InputError(f"{where}: AELIST {surf.alid1}: box {stray[0]} is on no CAERO1")
+        for p in panels:
+            strips = sorted({p.box(b)[0] for b in boxes if p.box(b) is not None})
+            if strips and strips != list(range(strips[0], strips[-1] + 1)):
+                raise InputError(
+                    f"{where}: AELIST {surf.alid1}: its boxes on CAERO1 {p.eid} lie in strips "
+                    f"{strips}, not one continuous span"
+                )
         out.append((str(surf.label), boxes))
     return tuple(out)
 
@@ -233,6 +255,11 @@ def aero_deck(path: Path, model, units: UnitSystem) -> AeroDeck | None:
     sym = int(getattr(ref, "sym_xz", 0) or 0) if ref is not None else 0
     panels = _panels(path, model, units, notes)
     flutter = _flutter_case(path, model, units, notes)
+    if flutter is not None and not rho_deck:
+        raise InputError(
+            f"{path}: FLUTTER {flutter.sid}: its densities are ratios of AERO's RHOREF, and the "
+            "deck has no AERO card (AEROS has no density): add AERO with RHOREF"
+        )
     param = model.params.get("LMODES")
     ratio = flutter.density_ratios[0] if flutter and flutter.density_ratios else 1.0
     card = f"FLFACT {flutter.cards.split('FLFACT ')[1].split(',')[0]}" if flutter else "AERO"
@@ -270,6 +297,9 @@ def check_aero_references(path: Path, model) -> None:
             raise InputError(
                 f"{path}: {sp.type} {eid}: SETG = {sp.setg}: SET1 {sp.setg} is missing"
             )
+        missing = [g for g in model.sets[sp.setg].ids if g not in model.nodes]
+        if missing:
+            raise InputError(f"{path}: SET1 {sp.setg}: GRID {missing[0]} is missing")
     for aesid, surf in sorted(model.aesurf.items()):
         for key in ("alid1", "alid2"):
             lid = getattr(surf, key, None)

@@ -238,6 +238,12 @@ def element_values(
         out[key] = given
     plane = be.flap_plane
     i_flap = sec.I1 if plane == "I1" else sec.I2
+    if not i_flap > 0.0:
+        raise InputError(
+            f"{sec.label}: {plane} = 0 is the flapwise moment of {e.card} {e.eid} (its plane "
+            f"{plane[1]} is vertical by its orientation vector): give {plane}, or orient the "
+            "element's vector up"
+        )
     out["EI"] = (sec.E * i_flap, f"E*{plane} of {sec.label} (plane {plane[1]} is vertical)")
     out["GJ"] = (sec.G * sec.J, f"G*J of {sec.label}")
     given = opts.value("mass", mid)

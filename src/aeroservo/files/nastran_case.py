@@ -29,6 +29,7 @@ __all__ = [
     "analysis_tables",
     "scenario_text",
     "case_v_max",
+    "box_counts",
 ]
 
 COVER_TOLERANCE = 1e-3
@@ -107,8 +108,10 @@ def panel_geometry(path: Path, aero: AeroDeck, line, grids: dict, up: np.ndarray
         b = 0.5 * chord * math.cos(be.sweep)
         src = f"{names}: streamwise chord {chord:.6g} m"
         out[e.eid] = {
-            "semichord": (float(f"{b:.12g}"), f"{src} x cos(sweep) / 2 (normal to the beam)"),
-            "a": (round(2.0 * frac - 1.0, 9), f"{names}: the beam at {frac:.6g} chord"),
+            # to the 7 digits of the deck's 8-character fields, so that the elements of one
+            # straight panel make one segment
+            "semichord": (float(f"{b:.7g}"), f"{src} x cos(sweep) / 2 (normal to the beam)"),
+            "a": (round(2.0 * frac - 1.0, 6), f"{names}: the beam at {frac:.6g} chord"),
         }
     return out
 
@@ -160,7 +163,9 @@ def case_v_max(aero: AeroDeck, frequencies) -> float | None:
     return float(min(v, 1000.0))
 
 
-def analysis_tables(aero: AeroDeck, n_elements: int, notes: list[str], v_max=None) -> str:
+def analysis_tables(
+    aero: AeroDeck, n_elements: int, boxes: tuple, v_max: float | None = None
+) -> str:
     """The wing file's ``[analysis]`` and ``[dlm]`` tables of the deck's aerodynamic model
     (``v_max``: :func:`case_v_max`)."""
     lines = ["[analysis]"]
@@ -177,7 +182,7 @@ def analysis_tables(aero: AeroDeck, n_elements: int, notes: list[str], v_max=Non
     if v_max is not None:
         lines.append(f"v_max = {v_max:.6g}  # covers FLUTTER {fc.sid}'s velocities or k")
     if aero.panels:
-        lines += ["", "[dlm]"] + _dlm_keys(aero, notes)
+        lines += ["", "[dlm]"] + _dlm_keys(aero, boxes)
     return "\n".join(lines) + "\n"
 
 
@@ -188,17 +193,41 @@ def _density(aero: AeroDeck) -> float | None:
     return check_quantity(aero.density_card[0], value, "density")
 
 
-def _dlm_keys(aero: AeroDeck, notes: list[str]) -> list[str]:
-    chord = sorted({p.nchord for p in aero.panels})
-    if len(chord) > 1:
-        notes.append(f"CAERO1 NCHORD {chord}: the doublet lattice takes {chord[-1]} everywhere")
+def box_counts(aero: AeroDeck, up: np.ndarray, pieces: int, notes: list[str]) -> tuple:
+    """The doublet lattice's boxes from the deck's: chordwise, the most boxes any section has
+    across the panels stacked along the flow there; spanwise, the strips between the distinct
+    strip edges of all panels (panels side by side add, stacked ones share), at least one per
+    spanwise piece of the wing (``pieces``: segments and control-surface edges)."""
+    lat = _lateral(aero, up)
+    edges, chord = [], 0
+    for p in aero.panels:
+        e1, e4 = float(p.p1 @ lat), float(p.p4 @ lat)
+        edges += [e1 + (e4 - e1) * k / p.nspan for k in range(p.nspan + 1)]
+    scale = max(abs(e) for e in edges) or 1.0
+    edges = np.unique(np.round(np.asarray(edges) / scale, 6))
+    spanwise = 0
+    for a, b in zip(edges[:-1], edges[1:], strict=False):
+        mid = 0.5 * (a + b) * scale
+        hits = [p for p in aero.panels if _at(p, mid, lat, 0.0) is not None]
+        if hits:
+            spanwise += 1
+            chord = max(chord, sum(p.nchord for p in hits))
     if not all(p.uniform for p in aero.panels):
         notes.append("CAERO1 LSPAN/LCHORD (AEFACT): the doublet lattice takes equal boxes")
-    spanwise = sum(p.nspan for p in aero.panels)
+    if spanwise < pieces:
+        notes.append(
+            f"the deck's {spanwise} strips are fewer than the wing's {pieces} spanwise pieces "
+            f"(segments and control-surface edges): the doublet lattice takes {pieces}"
+        )
+        spanwise = pieces
+    return chord, spanwise
+
+
+def _dlm_keys(aero: AeroDeck, boxes: tuple) -> list[str]:
     ids = ", ".join(str(p.eid) for p in aero.panels)
     keys = [
-        f"chordwise = {chord[-1]}  # CAERO1 {ids} NCHORD",
-        f"spanwise = {spanwise}  # CAERO1 {ids} NSPAN",
+        f"chordwise = {boxes[0]}  # CAERO1 {ids}: NCHORD",
+        f"spanwise = {boxes[1]}  # CAERO1 {ids}: NSPAN",
     ]
     if aero.symmetry == -1:
         raise InputError(
@@ -213,7 +242,14 @@ def _dlm_keys(aero: AeroDeck, notes: list[str]) -> list[str]:
 
 
 def scenario_text(
-    aero: AeroDeck, wing_file: str, name: str, deck: Path, units, n_elements: int, v_max=None
+    aero: AeroDeck,
+    wing_file: str,
+    name: str,
+    deck: Path,
+    units,
+    n_elements: int,
+    boxes: tuple,
+    v_max: float | None = None,
 ) -> str | None:
     """A flutter scenario running the deck's flutter case (None without a FLUTTER card)."""
     fc = aero.flutter
@@ -244,7 +280,7 @@ def scenario_text(
         rows += ['aero = "dlm"']
         if fc.machs:
             rows.append(f"mach = {fc.machs[0]:.10g}")
-        rows += ["", "[model.dlm]"] + [k.split("  #")[0] for k in _dlm_keys(aero, [])]
+        rows += ["", "[model.dlm]"] + [k.split("  #")[0] for k in _dlm_keys(aero, boxes)]
     rows += ["", "[sol145]", f'method = "{fc.method}"']
     if fc.method in PK_METHODS and fc.velocities:
         factor = units.length

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -19,7 +18,14 @@ import numpy as np
 
 from ..errors import InputError
 from .nastran_aero import AERO_CARDS, AeroDeck, aero_deck, check_aero_references
-from .nastran_masses import MASS_CARDS, PointMass, frame_axes, point_mass
+from .nastran_masses import (
+    MASS_CARDS,
+    PointMass,
+    check_mass_references,
+    frame_axes,
+    point_mass,
+)
+from .nastran_reader import first_line, parse_deck, pynastran_bdf
 from .nastran_sections import Section, section_of, tapered
 from .nastran_units import UnitSystem, unit_hint, unit_system
 
@@ -93,37 +99,6 @@ class Deck:
     aero: AeroDeck | None = None
 
 
-def pynastran_bdf():
-    """pyNastran's ``BDF`` class, or a one-line :class:`InputError` saying how to install it."""
-    try:
-        import numpy as np_
-
-        old = "in1d"  # pyNastran 1.4 binds np.in1d on import; numpy 2.4 removed it
-        shim = not hasattr(np_, old)
-        if shim:
-            setattr(np_, old, lambda a, b, **kw: np_.isin(np_.ravel(a), b, **kw))
-        try:
-            from pyNastran.bdf.bdf import BDF
-        finally:
-            if shim:
-                delattr(np_, old)
-    except ImportError:
-        raise InputError(
-            "reading a Nastran deck needs pyNastran, an optional dependency: "
-            "pip install 'aeroservo[nastran]' (docs/nastran.md)"
-        ) from None
-    return BDF
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip()
-    line = text.splitlines()[0].strip() if text else type(exc).__name__
-    card = re.search(r"card=\[\s*'(\w+)'\s*,\s*'?(\w+)", text)
-    if card:
-        line += f" (card {card.group(1)} {card.group(2)})"
-    return line[:300]
-
-
 def read_deck(path: str | Path, units: str | UnitSystem | None = None) -> Deck:
     """Read a stick-model deck and convert it to SI.
 
@@ -143,30 +118,18 @@ def read_deck(path: str | Path, units: str | UnitSystem | None = None) -> Deck:
     """
     units = unit_system(units)
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read the deck: {exc.strerror or exc}") from None
-    BDF = pynastran_bdf()
-    from cpylog import SimpleLogger
-
-    model = BDF(log=SimpleLogger(level="critical"))
-    punch = re.search(r"^\s*BEGIN\s+BULK", text, re.I | re.M) is None
+    model = parse_deck(path)
     sink = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
-            model.read_bdf(str(path), punch=punch, xref=False)
-    except Exception as exc:  # pyNastran raises many kinds on a malformed deck
-        raise InputError(f"{path}: cannot read the deck: {_first_line(exc)}") from None
     noted = _check_cards(path, model)
-    _apply_grdset(model)
+    grdset = _apply_grdset(model)
     _check_references(path, model)
     check_aero_references(path, model)
+    check_mass_references(path, model)
     try:
         with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
             model.cross_reference()
     except Exception as exc:
-        raise InputError(f"{path}: {_first_line(exc)}") from None
+        raise InputError(f"{path}: {first_line(exc)}") from None
     deck = _extract(path, model, units)
     aero = aero_deck(path, model, units)
     evidence = {
@@ -177,7 +140,7 @@ def read_deck(path: str | Path, units: str | UnitSystem | None = None) -> Deck:
     if aero is not None and aero.rho_ref_deck:
         evidence = {"air": (aero.rho_ref_deck * aero.density_ratio, *aero.density_card)} | evidence
     unit_hint(path, units, evidence)
-    notes = list(deck.notes)
+    notes = list(deck.notes) + ([grdset] if grdset else [])
     if noted:
         notes.append(f"left out (loads, output, design, trim): {noted}")
     if aero is not None:
@@ -185,11 +148,12 @@ def read_deck(path: str | Path, units: str | UnitSystem | None = None) -> Deck:
     return replace(deck, notes=tuple(notes), aero=aero)
 
 
-def _apply_grdset(model) -> None:
-    """GRDSET's CP, CD and PS on every GRID that leaves them blank (or 0)."""
+def _apply_grdset(model) -> str:
+    """GRDSET's CP, CD and PS on every GRID that leaves them blank (or 0), and a note saying so
+    ('' without a GRDSET)."""
     gs = getattr(model, "grdset", None)
     if gs is None:
-        return
+        return ""
     for grid in model.nodes.values():
         if not grid.cp and gs.cp:
             grid.cp = gs.cp
@@ -198,6 +162,13 @@ def _apply_grdset(model) -> None:
         if not grid.ps and gs.ps:
             grid.ps = str(gs.ps)
     model.grdset = None
+    given = [f"{k} {v}" for k, v in (("CP", gs.cp), ("CD", gs.cd), ("PS", gs.ps)) if v]
+    return (
+        f"GRDSET {', '.join(given)} applied to every GRID whose field is blank or 0 (pyNastran "
+        "cannot tell an explicit 0 from a blank)"
+        if given
+        else ""
+    )
 
 
 _WHY = {
@@ -332,6 +303,10 @@ def _extract(path: Path, model, units: UnitSystem) -> Deck:
             raise InputError(f"{where}: warping scalar points SA/SB are not modelled")
         offt = getattr(elem, "offt", None) or "GGG"
         if not isinstance(offt, str):  # field 9 as the flag of older decks (1: X1-X3 a vector)
+            if int(offt) == 2 and getattr(elem, "g0", None) is None:
+                raise InputError(
+                    f"{where}: field 9 = 2 says field 6 is a grid G0, but X1-X3 are real numbers"
+                )
             offt = "GGG"
         if getattr(elem, "bit", None) is not None:
             raise InputError(f"{where}: BIT field (curved beam) is not supported; use OFFT")
@@ -357,7 +332,7 @@ def _extract(path: Path, model, units: UnitSystem) -> Deck:
     if taper:
         notes.append(
             f"tapered PBEAM/PBEAML {', '.join(map(str, taper))}: each element takes its section "
-            "at mid-length (linear between the stations)"
+            "averaged over its length (linear between the stations)"
         )
     masses = [
         point_mass(path, m, model, cd_axes, wtmass, units) for _, m in sorted(model.masses.items())

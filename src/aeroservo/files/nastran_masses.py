@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from .nastran_units import UnitSystem
 
-__all__ = ["PointMass", "point_mass", "frame_axes", "MASS_CARDS"]
+__all__ = ["PointMass", "point_mass", "frame_axes", "check_mass_references", "MASS_CARDS"]
 
 MASS_CARDS = ("CONM2", "CONM1", "CMASS1", "CMASS2", "PMASS")
 """Mass cards read (PMASS: the property of CMASS1)."""
@@ -124,6 +124,8 @@ def point_mass(
         if value < 0.0:
             raise InputError(f"{where}: M = {value:g}: a mass must be >= 0")
         comp, nid = int(comps[0]), nids[0]
+        if not 1 <= comp <= 6:
+            raise InputError(f"{where}: component {comp}: expected 1 to 6")
         if nid not in model.nodes:
             raise InputError(f"{where}: GRID {nid} is missing (a scalar point is not supported)")
         pos = np.asarray(model.nodes[nid].get_position(), dtype=float) * l_unit
@@ -134,3 +136,10 @@ def point_mass(
         matrix[3:, 3:] = m_unit * l_unit**2 * value * np.outer(axis, axis)
         return PointMass(card.type, card.eid, nid, 0.0, pos, np.zeros((3, 3)), matrix=matrix)
     raise InputError(f"{where}: mass card not supported (CONM2, CONM1, CMASS1, CMASS2)")
+
+
+def check_mass_references(path: Path, model) -> None:
+    """A CMASS1's PMASS, named before pyNastran's cross-referencing would (one line)."""
+    for eid, card in sorted(model.masses.items()):
+        if card.type == "CMASS1" and card.pid not in model.properties_mass:
+            raise InputError(f"{path}: CMASS1 {eid}: PMASS {card.pid} is missing")

@@ -83,14 +83,17 @@ def pbarl_section(kind: str, dim: list[float]) -> tuple[float, float, float, flo
     raise ValueError(f"TYPE = {kind!r} is not supported ({', '.join(PBARL_TYPES)} are)")
 
 
-def _mid(prop, values) -> float:
-    """A PBEAM/PBEAML value at mid-length: linear between its stations (XXB)."""
+def _mean(prop, values) -> float:
+    """A PBEAM/PBEAML value averaged over the element's length, linear between its stations
+    (XXB; the end values held outside them): the mid-length value when it has two."""
     arr = np.atleast_1d(np.asarray(values, dtype=float))
     xxb = np.atleast_1d(np.asarray(getattr(prop, "xxb", [0.0]), dtype=float))
     if arr.size < 2 or xxb.size != arr.size:
         return float(arr[0]) if arr.size else 0.0
     order = np.argsort(xxb)
-    return float(np.interp(0.5, xxb[order], arr[order]))
+    x, y = xxb[order], arr[order]
+    x, y = np.concatenate([[0.0], x, [1.0]]), np.concatenate([[y[0]], y, [y[-1]]])
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
 
 
 def tapered(prop) -> bool:
@@ -107,8 +110,8 @@ def tapered(prop) -> bool:
 def section_of(path: Path, prop, mat, wtmass: float, units: UnitSystem) -> Section:
     """The :class:`Section` of a pyNastran property card and its MAT1, in SI.
 
-    A PBEAM or PBEAML with stations (a tapered element) gives its values at mid-length, linear
-    between the stations (the element's stiffness and mass to second order in its length).
+    A PBEAM or PBEAML with stations (a tapered element) gives each value averaged over the
+    element, linear between the stations (its mid-length value with two stations).
     """
     where = f"{path}: {prop.type} {prop.pid}"
     label = f"{prop.type} {prop.pid}, MAT1 {mat.mid}"
@@ -118,7 +121,7 @@ def section_of(path: Path, prop, mat, wtmass: float, units: UnitSystem) -> Secti
     rho = wtmass * float(mat.rho or 0.0) * units.density
     L, m_len = units.length, wtmass * units.mass / units.length  # NSM [mass/length]
     if prop.type in ("PBAR", "PBEAM"):
-        vals = {k: _mid(prop, getattr(prop, k)) for k in ("A", "i1", "i2", "i12", "j")}
+        vals = {k: _mean(prop, getattr(prop, k)) for k in ("A", "i1", "i2", "i12", "j")}
         if vals["i12"] != 0.0:
             raise InputError(
                 f"{where}: I12 = {vals['i12']:g}: a section whose principal axes are not the "
@@ -131,12 +134,12 @@ def section_of(path: Path, prop, mat, wtmass: float, units: UnitSystem) -> Secti
         kind = getattr(prop, "beam_type", None) or getattr(prop, "Type", None)
         dims = prop.dim if prop.type == "PBARL" else np.asarray(prop.dim, dtype=float)
         if prop.type == "PBEAML":
-            dims = [_mid(prop, dims[:, k]) for k in range(dims.shape[1])]
+            dims = [_mean(prop, dims[:, k]) for k in range(dims.shape[1])]
         try:
             a_, i1, i2, j_ = pbarl_section(str(kind), list(dims))
         except ValueError as exc:
             raise InputError(f"{where}: {exc}; or give A, I1, I2, J on a PBAR") from None
-        nsm = _mid(prop, prop.nsm) if prop.type == "PBEAML" else float(prop.nsm or 0.0)
+        nsm = _mean(prop, prop.nsm) if prop.type == "PBEAML" else float(prop.nsm or 0.0)
         vals = (a_ * L**2, i1 * L**4, i2 * L**4, j_ * L**4)
         sec = Section(f"{label} ({kind})", prop.pid, E, G, rho, *vals, m_len * nsm)
     elif prop.type == "PBEAM":
@@ -161,7 +164,7 @@ def section_of(path: Path, prop, mat, wtmass: float, units: UnitSystem) -> Secti
             vals["i1"] * L**4,
             vals["i2"] * L**4,
             vals["j"] * L**4,
-            m_len * _mid(prop, getattr(prop, "nsm", [0.0])),
+            m_len * _mean(prop, getattr(prop, "nsm", [0.0])),
             nsi=m_len * L**2 * ends["nsi"],
             m1=ends["m1"] * L,
             m2=ends["m2"] * L,
