@@ -22,10 +22,13 @@ The unit factors are written here from their definitions (1 in = 0.0254 m, 1 lbf
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -36,6 +39,7 @@ pytest.importorskip(
     "installs it): the Nastran flutter decks are not tested",
 )
 
+from aeroservo.cli import main  # noqa: E402
 from aeroservo.errors import InputError  # noqa: E402
 from aeroservo.files.nastran import read_nastran  # noqa: E402
 from aeroservo.files.nastran_deck import pynastran_bdf  # noqa: E402
@@ -65,10 +69,20 @@ COSMIC_BENDING = {4000.0: (-2.9506537e-01, 49.296200), 6200.0: (-8.0324262e-01, 
 MSC_KE = (6004.2 * IN, 140.1)  # pt145.f06 POINT 2 interpolated at g = 0
 
 
-def _cli(*args, cwd):
+def _subprocess(*args, cwd):
+    """The command as a user types it (a new interpreter)."""
     return subprocess.run(
         [sys.executable, "-m", "aeroservo", *args], capture_output=True, text=True, cwd=cwd
     )
+
+
+def _cli(*args, cwd):
+    """The command run in this process (``aeroservo.cli.main``: the same exit codes and
+    messages, without an interpreter's start-up for every case)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(cwd), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
 
 
 def _crossing(rows):
@@ -84,7 +98,7 @@ def _crossing(rows):
 def sample(tmp_path_factory):
     """The sample deck imported by the README's command, and its flutter scenario run."""
     tmp = tmp_path_factory.mktemp("sample")
-    run = _cli(
+    run = _subprocess(
         "import", "nastran", str(SAMPLE), "--units", "in-lbf-s", "--out", "wing.toml", cwd=tmp
     )
     assert run.returncode == 0, run.stderr
@@ -641,3 +655,13 @@ def test_pbeam_three_stations_average(tmp_path):
 
     seg = _read(tmp_path, _beam(pbeam=pbeam)).wing.segments[0]
     assert seg.mass == pytest.approx(2700.0 * 0.0175, rel=1e-12)
+
+
+def test_frequency_check_names_the_units(tmp_path):
+    """A companion inertia in the wrong units (1e-12 kg m) gives a torsion frequency of 1 MHz:
+    one line saying the deck was read as in-lbf-s and the companion values are SI."""
+    comp = tmp_path / "c.toml"
+    comp.write_text("inertia = 1e-12\n")
+    with pytest.raises(InputError, match="read as in-lbf-s .* companion values are SI") as info:
+        read_nastran(SAMPLE, units="in-lbf-s", companion=comp)
+    assert "\n" not in str(info.value) and "torsion frequency" in str(info.value)

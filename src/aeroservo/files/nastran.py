@@ -116,7 +116,7 @@ def read_nastran(
     try:
         segs, headers, sources = segments(line, opts, geometry)
     except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+        raise InputError(f"{path}: {_unit_text(exc, data.units)}") from None
     masses, mass_notes, left = point_masses(data, root, line, opts.up)
     span = line[-1].end
     chord_hint(path, span, segs, sources, data.units)
@@ -140,7 +140,7 @@ def read_nastran(
             masses=tuple(masses),
         )
     except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+        raise InputError(f"{path}: {_unit_text(exc, data.units)}") from None
     left = [*left, *_unused_grids(data, line, root)]
     notes = [data.units.describe(), *data.notes]
     tables, scenario = "", None
@@ -210,6 +210,15 @@ def _frequencies(wing: Wing, n_elements: int, aero) -> list[float]:
     model = AeroelasticModel(wing, max(n_elements, 2) if n_elements <= 300 else 300)
     n = min(aero.lmodes or 3, model.n_dofs)
     return list(model.natural_modes(n).frequencies)
+
+
+def _unit_text(exc: InputError, units) -> str:
+    """A wing check's unit hint, told which units the deck was read in."""
+    return str(exc).replace(
+        "check the units [SI]",
+        f"the deck was read as {units.name} (--units) and converted to SI; options and "
+        "companion values are SI: check both",
+    )
 
 
 def _not_an_input(what: str, out: Path | str, inputs: dict) -> None:
