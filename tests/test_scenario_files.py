@@ -450,3 +450,21 @@ def test_fuzz_load_scenario_mutated(tree, data):
     path = tree / "scenarios" / "fuzz_doc.toml"
     path.write_text(_toml(doc), encoding="utf-8")
     _only_input_error(lambda: load_scenario(path), str(path))
+
+
+def test_controller_file_margin_requirement(tmp_path):
+    """`[margins] delay_ms` and `at` (issue 38): read into the requirement; an unknown break
+    point is one line naming the key."""
+    from aeroservo.files.controller_file import load_controller
+
+    path = tmp_path / "c.toml"
+    path.write_text(
+        'type = "lqr"\n[weights]\noutputs = { tip_disp = 0.01 }\n'
+        "inputs = { aileron_hinge_moment = 100.0 }\n"
+        '[margins]\ndelay_ms = 10.0\nat = ["inputs", "sensors"]\n'
+    )
+    req = load_controller(path).margins
+    assert req.delay_ms == 10.0 and req.at == ("inputs", "sensors")
+    path.write_text(path.read_text().replace('"sensors"', '"actuators"'))
+    with pytest.raises(InputError, match=r"margins.at = .*allowed break points"):
+        load_controller(path)

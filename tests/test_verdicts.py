@@ -125,3 +125,31 @@ def test_osqp_keeps_json_parseable(tmp_path, capfd):
     assert code == 0
     summary = json.loads(out)
     assert summary["controller_type"] == "mpc" and summary["verdict"] == "stable"
+
+
+def test_hint_tells_a_wrong_sign_from_a_saturation_loss():
+    """Issue 38: the shipped LQR with its gain's sign reversed is unstable and the same law
+    with the right sign is stable: the hint says to check the sign; a stable linear loop
+    whose signals still grow is a loss to the limits, and the hint says so (not the design
+    advice). Keys the hints name exist (hinf.bandwidth, not weights.bandwidth)."""
+    from dataclasses import replace
+
+    from aeroservo.studies.verdict import _REMEDIES, loop_verdict
+
+    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
+    model = sc.model()
+    from aeroservo.stability.boundary import flutter_boundary
+
+    vf = flutter_boundary(model, sc.density).flutter_speed
+    loop = sc.loop(model)
+    speed = sc.speed_factor * vf
+    ctrl = loop.design_controller(sc.controller, speed, sc.sample_rate, vf)
+    plant = loop.plant(speed)
+    wrong = replace(ctrl, K=-ctrl.K, Kd=-ctrl.Kd)
+    v = loop_verdict(plant, wrong, False, {"tip_disp": {"growth": 5.0}})
+    assert v["verdict"] == "unstable" and "opposite sign is stable" in v["hint"]
+    ok = loop_verdict(
+        plant, ctrl, False, {"tip_disp": {"growth": 5.0}}, {"aileron_hinge_moment": 0.9}
+    )
+    assert ok["spectral_radius"] < 1 and "actuator limits lose it" in ok["hint"]
+    assert "weights.bandwidth" not in " ".join(_REMEDIES.values())

@@ -128,9 +128,13 @@ def _channel_text(c: dict) -> str:
         return "closed loop unstable"
     pm = "inf" if c["phase_margin_deg"] is None else f"{c['phase_margin_deg']:.3g} deg"
     at = "" if c["phase_frequency"] is None else f" at {c['phase_frequency']:.3g} Hz"
+    tau = c.get("delay_margin_s")
+    delay = (
+        "inf" if tau is None else f"{tau * 1e3:.3g} ms ({c['delay_margin_samples']:.3g} samples)"
+    )
     return (
         f"gain {db(c['gain_margin_db'])} / {db(c['gain_reduction_margin_db'], '-')}, "
-        f"phase {pm}{at}, disk {c['disk_margin']:.3g}"
+        f"phase {pm}{at}, delay {delay}, disk {c['disk_margin']:.3g}"
     )
 
 
@@ -143,10 +147,12 @@ def _margin_lines(m: dict | None) -> list[str]:
         f"disk {r['disk_alpha']:g}"
         if r["disk_alpha"] is not None
         else f"{r['gain_db']:g} dB, {r['phase_deg']:g} deg"
-    )
-    out = [f"  margins at {m['speed']:.5g} m/s, broken at the {m['break_point']}:"]
+    ) + (f", {r['delay_ms']:g} ms" if r.get("delay_ms") is not None else "")
+    at = r.get("at", ["inputs"])
+    verdict = f"{'meets' if m['meets'] else 'misses'} {req} at the {', '.join(at)}"
+    out = [f"  margins at {m['speed']:.5g} m/s ({verdict}); broken at the {m['break_point']}:"]
     for name, c in m["channels"].items():
-        out.append(f"    {name}: {_channel_text(c)} ({'meets' if m['meets'] else 'misses'} {req})")
+        out.append(f"    {name}: {_channel_text(c)}")
     multi = m.get("multiloop") or {}
     if len(m["channels"]) > 1 and multi.get("disk_margin") is not None:
         out.append(f"    all inputs at once: disk {multi['disk_margin']:.3g} ({multi['method']})")
@@ -156,8 +162,17 @@ def _margin_lines(m: dict | None) -> list[str]:
             f"Hz, peak |T| {m['peak_complementary_sensitivity']:.3g} at "
             f"{m['peak_complementary_sensitivity_frequency']:.3g} Hz (plant input)"
         )
+    judged = "judged" if "sensors" in at else "reported"
     for name, c in m.get("sensors", {}).items():
-        out.append(f"    at sensor {name} (plant output): {_channel_text(c)}")
+        out.append(f"    at sensor {name} (plant output, {judged}): {_channel_text(c)}")
+    outs = m.get("multiloop_outputs") or {}
+    if len(m.get("sensors", {})) > 1 and outs.get("disk_margin") is not None:
+        judged = "judged" if "multiloop" in at else "reported"
+        out.append(
+            f"    all sensors at once ({judged}): disk {outs['disk_margin']:.3g} "
+            f"(+-{outs['disk_gain_margin_db']:.3g} dB, +-{outs['disk_phase_margin_deg']:.3g} deg "
+            f"at {outs['frequency']:.3g} Hz; {outs['method']})"
+        )
     return out
 
 
@@ -249,7 +264,9 @@ def _readable(s: dict) -> str:
             lines.append(
                 f"  closed loop loses stability at {f(c['closed_loop_flutter_speed'], ' m/s')}"
                 f" ({c['closed_loop_instability'] or 'not in range'}), lower end "
-                f"{f(c['lower_speed'], ' m/s')}; stable intervals "
+                f"{f(c['lower_speed'], ' m/s')}"
+                + (f" ({c['lower_speed_kind']})" if c.get("lower_speed_kind") else "")
+                + "; stable intervals "
                 f"{[(round(a, 2), round(b, 2)) for a, b in c['stable_intervals']]}"
             )
     else:

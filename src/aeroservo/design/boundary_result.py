@@ -104,6 +104,19 @@ class ClosedLoopBoundary:
         return None
 
     @property
+    def lower_speed_kind(self) -> str | None:
+        """What :attr:`lower_speed` is: ``"search limit"`` (stable down to the lowest speed
+        searched) or ``"stability boundary (...)"`` naming the loss below it; None with it."""
+        v = self.lower_speed
+        if v is None:
+            return None
+        if v <= float(self.speeds[0]):
+            return "search limit (stable down to the lowest speed searched)"
+        c = next((c for c in self.crossings if c["speed"] == v), None)
+        loss = "" if c is None else f" ({loss_name(c['static'], c['frequency'])} below it)"
+        return "stability boundary" + loss
+
+    @property
     def stable_intervals(self) -> list[tuple[float, float]]:
         """Speed intervals [m/s] inside the searched range where the loop is stable.
 
@@ -175,6 +188,7 @@ class ClosedLoopBoundary:
             if f is None
             else loss_name(f["static"], f["frequency"]),
             "lower_speed": self.lower_speed,
+            "lower_speed_kind": self.lower_speed_kind,
             "reference_speed": self.reference_speed,
             "stable_at_reference": self.stable_at_reference,
             "sampled": self.sampled,

@@ -164,19 +164,23 @@ class LoopJudgement:
             )
         fails = self.margin_failures()
         if fails and self.stable:
-            r = self.requirement
-            req = (
-                f"a disk margin of {r.disk_alpha:g}"
-                if r.disk_alpha is not None
-                else f"{r.gain_db:g} dB, {r.phase_deg:g} deg"
+            req = self.requirement.describe()
+            # the reference (design) speed first, then the worst: nothing decisive is folded
+            ref = getattr(self.boundary, "reference_speed", None)
+            order = sorted(
+                fails,
+                key=lambda f: (
+                    ref is None or abs(f["speed"] - ref) > 1e-9 * ref,
+                    -len(f["violations"]),
+                ),
             )
             shown = "; ".join(
-                f"at {f['speed']:.4g} m/s {', '.join(f['violations'])}" for f in fails[:3]
+                f"at {f['speed']:.4g} m/s {', '.join(f['violations'])}" for f in order[:3]
             )
-            more = f" (and {len(fails) - 3} more speeds)" if len(fails) > 3 else ""
+            rest = sorted(f["speed"] for f in order[3:])
+            more = f" (also at {', '.join(f'{v:.4g}' for v in rest)} m/s)" if rest else ""
             out.append(
-                f"loop margins at the actuator (controller a black box) miss {req} in {where}: "
-                f"{shown}{more}"
+                f"loop margins (controller a black box) miss {req} in {where}: {shown}{more}"
             )
         return out
 
@@ -187,6 +191,7 @@ class LoopJudgement:
             "stable_over_range": self.stable,
             "unstable_intervals": self.unstable,
             "lower_speed": self.boundary.lower_speed,
+            "lower_speed_kind": self.boundary.lower_speed_kind,
             "margins_over_range": {
                 "meets": self.meets_requirement,
                 "speeds": [] if self.sweep is None else self.sweep.speeds.tolist(),

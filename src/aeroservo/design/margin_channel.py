@@ -32,41 +32,21 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.optimize as so
 
-from ..errors import check_number
+from .margin_requirement import BREAK_POINT_KEYS, MarginRequirement
 
-__all__ = ["MarginRequirement", "ChannelMargins", "channel_margins", "frequency_response"]
+__all__ = [
+    "MarginRequirement",
+    "ChannelMargins",
+    "channel_margins",
+    "frequency_response",
+    "BREAK_POINT_KEYS",
+]
 
 PHASE_STEP = 0.2
 """Largest change [rad] of the phase (and log-magnitude) of ``1 + L`` between grid points."""
 
 MAX_POINTS = 200_000
 """Cap on the refined frequency grid."""
-
-
-@dataclass(frozen=True)
-class MarginRequirement:
-    """Stability-margin requirement at the actuator (controller file ``[margins]``).
-
-    Attributes
-    ----------
-    gain_db : float
-        Required gain margin, both ways [dB] (MIL-F-9490D: 6).
-    phase_deg : float
-        Required phase margin [deg] (MIL-F-9490D: 45).
-    disk_alpha : float or None
-        If set, the balanced disk margin ``alpha`` required instead of the gain and phase
-        margins (e.g. 0.67 tolerates +-6 dB and +-37 deg simultaneously).
-    """
-
-    gain_db: float = 6.0
-    phase_deg: float = 45.0
-    disk_alpha: float | None = None
-
-    def __post_init__(self) -> None:
-        check_number("margins.gain_db", self.gain_db, unit="dB", lo=0.0)
-        check_number("margins.phase_deg", self.phase_deg, unit="deg", lo=0.0, hi=180.0)
-        if self.disk_alpha is not None:
-            check_number("margins.disk_alpha", self.disk_alpha, lo=0.0, hi=2.0, lo_open=True)
 
 
 @dataclass
@@ -95,6 +75,14 @@ class ChannelMargins:
         Balanced disk margin ``alpha`` (0 if the closed loop is unstable), at
         ``disk_frequency`` [Hz]; ``disk_gain_margin_db`` and ``disk_phase_margin_deg`` are the
         simultaneous gain and phase variations it tolerates.
+    delay_margin : float
+        [s] the smallest pure time delay that puts a closed-loop pole on the unit circle:
+        at each gain crossover (``|L| = 1``, angular frequency w) the lag that takes ``L`` to
+        -1, ``((arg L + pi) mod 2 pi) / w``, the least of them (inf without a crossover), at
+        ``delay_frequency`` [Hz]; a delay of k samples is ``z^-k``, so the loop with any
+        integer number of extra samples below it stays stable.
+    dt : float
+        The loop's sample period [s].
     omega : ndarray
         Refined grid [rad/s] from 0 to the Nyquist frequency; ``response`` is ``L`` on it.
     """
@@ -113,6 +101,9 @@ class ChannelMargins:
     disk_gain_margin_db: float
     disk_phase_margin_deg: float
     disk_frequency: float | None
+    delay_margin: float = np.inf
+    delay_frequency: float | None = None
+    dt: float = 0.0
     omega: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
     response: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
 
@@ -128,7 +119,7 @@ class ChannelMargins:
             return [f"{self.name}: closed loop unstable"]
         out = []
         if req.disk_alpha is not None:
-            return out
+            return out + self.delay_violations(req)
         if self.gain_margin_db < req.gain_db:
             out.append(f"{self.name}: gain margin {self.gain_margin_db:.3g} dB < {req.gain_db}")
         if self.gain_reduction_margin_db > -req.gain_db:
@@ -140,24 +131,36 @@ class ChannelMargins:
             out.append(
                 f"{self.name}: phase margin {self.phase_margin_deg:.3g} deg < {req.phase_deg}"
             )
-        return out
+        return out + self.delay_violations(req)
+
+    def delay_violations(self, req: MarginRequirement) -> list[str]:
+        """The delay requirement, if any."""
+        if req.delay_ms is None or not self.stable or self.delay_margin * 1e3 >= req.delay_ms:
+            return []
+        return [f"{self.name}: delay margin {self.delay_margin * 1e3:.3g} ms < {req.delay_ms:g}"]
 
     def to_dict(self) -> dict:
-        """JSON-ready (dB, deg, Hz; infinite margins as null)."""
+        """JSON-ready (dB, deg, Hz, s; infinite margins as null). An unstable closed loop has
+        no margins: they are null and ``stable`` is false."""
 
         def fin(x):
-            return None if x is None or not np.isfinite(x) else float(x)
+            return None if x is None or not self.stable or not np.isfinite(x) else float(x)
 
+        delay = fin(self.delay_margin)
         return {
             "stable": self.stable,
             "nyquist_stable": self.nyquist_stable,
             "open_loop_unstable_poles": self.open_loop_unstable,
             "encirclements": float(self.encirclements),
             "gain_margin_db": fin(self.gain_margin_db),
+            "gain_increase_frequency": fin(self.gain_frequencies[1]),
             "gain_reduction_margin_db": fin(self.gain_reduction_margin_db),
-            "gain_frequencies": [fin(f) for f in self.gain_frequencies],
+            "gain_reduction_frequency": fin(self.gain_frequencies[0]),
             "phase_margin_deg": fin(self.phase_margin_deg),
             "phase_frequency": fin(self.phase_frequency),
+            "delay_margin_s": delay,
+            "delay_margin_samples": None if delay is None or not self.dt else delay / self.dt,
+            "delay_frequency": fin(self.delay_frequency),
             "disk_margin": fin(self.disk_margin),
             "disk_gain_margin_db": fin(self.disk_gain_margin_db),
             "disk_phase_margin_deg": fin(self.disk_phase_margin_deg),
@@ -279,10 +282,16 @@ def channel_margins(A, B, C, name: str, dt: float) -> ChannelMargins:
     lm = np.log(np.maximum(np.abs(vals), 1e-300))
     cross = _roots(lambda t: float(np.log(abs(L(np.array([t]))[0]))), theta, lm)
     pm, pm_t = np.inf, None
+    tau, tau_t = np.inf, None
     for t in cross:
-        phi = float(np.degrees(abs(np.angle(-1.0 / L(np.array([t]))[0]))))
+        v = L(np.array([t]))[0]
+        phi = float(np.degrees(abs(np.angle(-1.0 / v))))
         if phi < pm:
             pm, pm_t = phi, t
+        lag = float(np.mod(np.angle(v) + np.pi, 2 * np.pi))  # the lag that takes L to -1
+        d = lag / t * dt if t > 0 else (0.0 if lag == 0.0 else np.inf)
+        if d < tau:
+            tau, tau_t = d, t
 
     # balanced disk margin
     alpha, disk_t = 0.0, None
@@ -324,6 +333,9 @@ def channel_margins(A, B, C, name: str, dt: float) -> ChannelMargins:
         disk_gain_margin_db=float(disk_gm),
         disk_phase_margin_deg=disk_pm,
         disk_frequency=freq(disk_t),
+        delay_margin=float(tau) if stable else 0.0,
+        delay_frequency=freq(tau_t),
+        dt=float(dt),
         omega=theta / dt,
         response=vals,
     )

@@ -134,7 +134,13 @@ def margins_over_speed(
     out: list[LoopMargins] = []
     for s in v:  # loop_margins evaluates a schedule at the plant's speed
         out.append(
-            loop_margins(at(float(s)), controller, delay=delay, requirement=req, sensors=False)
+            loop_margins(
+                at(float(s)),
+                controller,
+                delay=delay,
+                requirement=req,
+                sensors="sensors" in req.at,
+            )
         )
 
         if progress is not None:

@@ -123,6 +123,12 @@ class LoopBlocks:
         ``o = C z``; return ratio ``L = -o / w``."""
         return self.Az + self.Bv @ self.Cm, self.Bw, self.Co + self.Dv @ self.Cm
 
+    def at_sensors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C)`` broken at every measurement at once (inputs closed): the controller
+        reads ``v``, the loop gives back ``r = C z``; return ratio ``L = -r / v``."""
+        Gv = self.Bw @ self.Dv + self.Bv
+        return self.Az + self.Bw @ self.Co, Gv, self.Cm
+
     def at_sensor(self, j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(A, B, C)`` broken at measurement ``j`` (inputs and other sensors closed): the
         controller reads ``v`` for it, the loop gives back the true value ``r = C z``; return

@@ -16,7 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..design.hinf import HinfWeights
-from ..design.margins import MarginRequirement
+from ..design.margin_requirement import BREAK_POINT_KEYS, MarginRequirement
 from ..design.mpc import SOLVERS
 from ..design.plant import Limits
 from ..design.spec import CONTROLLER_TYPES, ControllerSpec
@@ -128,12 +128,20 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
             key = "outputs" if not kw["bryson_outputs"] else "inputs"
             w.fail(key, w.data[key], "give at least one allowed value")
         kw["state_weight"] = w.number("state_weight", 1e-8, lo=0.0, hi=1.0)
-    mg = top.table("margins").check_keys((), ("gain_db", "phase_deg", "disk_alpha"))
+    mg = top.table("margins").check_keys(
+        (), ("gain_db", "phase_deg", "disk_alpha", "delay_ms", "at")
+    )
     req = MarginRequirement()
+    at = mg.strings("at", list(req.at))
+    bad = [a for a in at if a not in BREAK_POINT_KEYS]
+    if bad:
+        mg.fail("at", at, f"allowed break points are {list(BREAK_POINT_KEYS)}")
     kw["margins"] = MarginRequirement(
         gain_db=mg.number("gain_db", req.gain_db, lo=0.0),
         phase_deg=mg.number("phase_deg", req.phase_deg, lo=0.0, hi=180.0),
         disk_alpha=mg.number("disk_alpha", None, lo=0.0, hi=2.0, lo_open=True),
+        delay_ms=mg.number("delay_ms", None, unit="ms", lo=0.0, hi=1e4),
+        at=tuple(at),
     )
 
     lim = top.table("limits").check_keys((), ("magnitude", "rate"))

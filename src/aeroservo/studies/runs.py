@@ -9,6 +9,7 @@ a run's summary, result file and figures as one set.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -180,17 +181,19 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     dist = scenario.disturbance
     x0 = loop.initial_state(dist.initial_tip) if dist.initial_tip else None
     noise = {k: np.sqrt(v) for k, v in scenario.sensor_noise.items()} or None
-    result = simulate(
-        plant,
-        at,
-        duration=scenario.duration,
-        x0=x0,
-        disturbance=dist.gust,
-        limits=spec.limits,
-        delay=scenario.delay,
-        sensor_noise=noise,
-        seed=scenario.seed,
-    )
+    with warnings.catch_warnings():  # the summary gives the windup warning, once
+        warnings.filterwarnings("ignore", message="simulate: the controller's commands run")
+        result = simulate(
+            plant,
+            at,
+            duration=scenario.duration,
+            x0=x0,
+            disturbance=dist.gust,
+            limits=spec.limits,
+            delay=scenario.delay,
+            sensor_noise=noise,
+            seed=scenario.seed,
+        )
     open_loop = None
     if scenario.plots and not isinstance(controller, OpenLoop):  # overlay of the figure
         open_loop = simulate(
@@ -239,7 +242,10 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         from ..simulate.result import windup_text
 
         summary["windup"] = wound
-        summary.setdefault("warnings", []).append(windup_text(wound))
+        if "hint" in summary:  # a lost run: its one line says it
+            summary["hint"] += f"; {windup_text(wound)}"
+        else:
+            summary.setdefault("warnings", []).append(windup_text(wound))
     if result.status:
         times = np.array([s["solve_time"] for s in result.status])
         summary["mpc"] = {

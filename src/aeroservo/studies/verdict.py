@@ -50,8 +50,27 @@ _REMEDIES = {
     "estimator": "try more design modes (model.design_modes), slower sensor filters "
     "(signals.sensor_filter) or a lower estimator gain (larger estimator.sensor_noise)",
     "compensator": "try more design modes (model.design_modes), a lower bandwidth "
-    "(weights.bandwidth) or slower sensor filters (signals.sensor_filter)",
+    "(hinf.bandwidth for an H-infinity design) or slower sensor filters "
+    "(signals.sensor_filter)",
+    "saturation": "the linear loop is stable, the actuator limits lose it: larger limits "
+    "(controller limits.magnitude, limits.rate), a smaller disturbance, or anti-windup "
+    "(controller anti_windup)",
+    "sign": "the same law with the opposite sign is stable: check the controller's sign (a "
+    "gain file closes u = -K y; a brought compensator u = +y_K, or its negative with "
+    "sign = -1; docs/controllers.md)",
 }
+
+
+def _flipped_is_stable(plant, law, delay: bool) -> bool:
+    """Whether the law with its command's sign reversed closes a stable sampled loop."""
+    from dataclasses import replace
+
+    from ..design.plant import SampledPlant
+    from ..design.sampled_loop import loop_matrix
+
+    flipped = replace(law, C=-law.C, D=-law.D)
+    sp = SampledPlant.from_statespace(plant, law.dt, list(law.controls), (), list(law.sensors))
+    return bool(np.max(np.abs(np.linalg.eigvals(loop_matrix(sp, flipped, delay)))) < 1.0)
 
 
 def loop_verdict(
@@ -119,6 +138,10 @@ def loop_verdict(
         )
         law = linear_law(controller, plant_states(plant))
         kind = "open" if not law.has_feedback else law.kind
+        if rho <= 1.0 + 1e-12:
+            kind = "saturation"
+        elif kind in ("state", "compensator") and _flipped_is_stable(plant, law, delay):
+            kind = "sign"
         hint = f"closed loop unstable: {why}; {_REMEDIES[kind]}"
         busy = {k: v for k, v in (limited or {}).items() if v >= 0.5}
         if busy:
