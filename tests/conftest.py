@@ -38,6 +38,21 @@ def needs_panelaero():
     )
 
 
+def designed_loop(stem: str):
+    """A shipped scenario's plant and designed controller at its design speed (a schedule
+    evaluated there): ``(plant, controller)``."""
+    from aeroservo.files import load_scenario
+    from aeroservo.stability.boundary import flutter_boundary
+
+    sc = load_scenario(ROOT / "scenarios" / f"{stem}.toml")
+    model = sc.model()
+    vf = flutter_boundary(model, sc.density).flutter_speed
+    loop = sc.loop(model)
+    speed = sc.speed_factor * vf
+    ctrl = loop.design_controller(sc.controller, speed, sc.sample_rate, vf)
+    return loop.plant(speed), ctrl.at(speed) if hasattr(ctrl, "at") else ctrl
+
+
 def reference(case_id: str) -> dict:
     """The reference case with this id."""
     cases = json.loads((DATA / "reference_cases.json").read_text())["cases"]

@@ -76,6 +76,8 @@ def test_loads_command_writes_the_set(cli_run):
     for f in FIGURES:
         assert (out / f"{STEM}_{f}.png").read_bytes()[:8] == PNG
     assert "open loop, worst limit load" in text and "closed loop, worst limit load" in text
+    # issue 38: the example's LQR is a state feedback; the report says what it measures
+    assert "the closed loop feeds back the plant state (state feedback): not realisable" in text
     doc = json.loads((out / f"{STEM}.json").read_text())
     assert sorted(Path(p).name for p in doc["files"].values()) == sorted(expected)
     for name in expected:

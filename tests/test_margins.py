@@ -6,15 +6,13 @@ brute force, on randomized low-order loops and on the shipped LQG loop; and pyth
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import designed_loop
 
 from aeroservo.design.margin_channel import channel_margins as _channel
 from aeroservo.design.margins import MarginRequirement, loop_margins
 from aeroservo.design.plant import SampledPlant
 from aeroservo.design.sampled_loop import broken_loop, linear_law
 from aeroservo.errors import InputError
-from aeroservo.files import load_scenario
-from aeroservo.stability.boundary import flutter_boundary
 
 DT = 1e-3
 
@@ -203,13 +201,7 @@ def test_unstable_loop_is_reported_by_both_criteria():
 
 @pytest.fixture(scope="module")
 def lqg_loop():
-    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqg.toml")
-    model = sc.model()
-    vf = flutter_boundary(model, sc.density).flutter_speed
-    loop = sc.loop(model)
-    speed = sc.speed_factor * vf
-    ctrl = loop.design_controller(sc.controller, speed, sc.sample_rate, vf)
-    return loop.plant(speed), ctrl.at(speed)  # the scheduled LQG at the design speed
+    return designed_loop("goland_aileron_lqg")  # the scheduled LQG at the design speed
 
 
 @pytest.mark.parametrize("measured", [False, True], ids=["black_box", "measured_input"])

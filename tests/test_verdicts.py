@@ -9,7 +9,7 @@ import shutil
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, designed_loop
 
 from aeroservo import cli
 from aeroservo.files import load_result, load_scenario
@@ -127,7 +127,13 @@ def test_osqp_keeps_json_parseable(tmp_path, capfd):
     assert summary["controller_type"] == "mpc" and summary["verdict"] == "stable"
 
 
-def test_hint_tells_a_wrong_sign_from_a_saturation_loss():
+@pytest.fixture(scope="module")
+def lqr_at_design():
+    """The shipped LQR scenario's plant and controller at its design speed."""
+    return designed_loop("goland_aileron_lqr")
+
+
+def test_hint_tells_a_wrong_sign_from_a_saturation_loss(lqr_at_design):
     """Issue 38: the shipped LQR with its gain's sign reversed is unstable and the same law
     with the right sign is stable: the hint says to check the sign; a stable linear loop
     whose signals still grow is a loss to the limits, and the hint says so (not the design
@@ -136,15 +142,7 @@ def test_hint_tells_a_wrong_sign_from_a_saturation_loss():
 
     from aeroservo.studies.verdict import _REMEDIES, loop_verdict
 
-    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
-    model = sc.model()
-    from aeroservo.stability.boundary import flutter_boundary
-
-    vf = flutter_boundary(model, sc.density).flutter_speed
-    loop = sc.loop(model)
-    speed = sc.speed_factor * vf
-    ctrl = loop.design_controller(sc.controller, speed, sc.sample_rate, vf)
-    plant = loop.plant(speed)
+    plant, ctrl = lqr_at_design
     wrong = replace(ctrl, K=-ctrl.K, Kd=-ctrl.Kd)
     v = loop_verdict(plant, wrong, False, {"tip_disp": {"growth": 5.0}})
     assert v["verdict"] == "unstable" and "opposite sign is stable" in v["hint"]
@@ -153,3 +151,37 @@ def test_hint_tells_a_wrong_sign_from_a_saturation_loss():
     )
     assert ok["spectral_radius"] < 1 and "actuator limits lose it" in ok["hint"]
     assert "weights.bandwidth" not in " ".join(_REMEDIES.values())
+
+
+def test_state_feedback_is_flagged_not_realisable(lqr_at_design, tmp_path, capsys):
+    """Issue 38: the shipped LQR feeds back plant states no sensor measures, among them the
+    two Kussner gust states (a perfect gust measurement): every simulate report says so, and
+    a scenario with `controller.realisable = true` refuses it in one line. Counted here from
+    the LQR's own gain on the plant state (u = -gain x) and the plant's state names."""
+    import re
+
+    from aeroservo.studies.verdict import loop_verdict
+
+    plant, ctrl = lqr_at_design
+    v = loop_verdict(plant, ctrl, False, {})
+    names = list(plant.state_labels)
+    gain = np.zeros((ctrl.gain.shape[0], len(names)))
+    gain[:, : ctrl.gain.shape[1]] = ctrl.gain
+    used = [n for n, col in zip(names, gain.T, strict=True) if np.any(col != 0)]
+    gust = [n for n in used if re.match(r"g\d+_", n)]
+    lag = [n for n in used if re.match(r"z\d+_", n)]
+    assert len(gust) == 2 and lag
+    assert v["realisable"] is False
+    assert v["unmeasured_feedback"]["gust states"] == 2
+    assert v["unmeasured_feedback"]["aerodynamic lag states"] == len(lag)
+    assert "perfect gust measurement" in v["warnings"][0]
+    path = variant(
+        tmp_path,
+        "goland_aileron_lqr",
+        "lqr.toml",
+        ("[controller]\n", "[controller]\nrealisable = true\n"),
+    )
+    code = cli.main(["run", str(path), "--quick", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "controller.realisable = true" in err[0], err
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())

@@ -305,8 +305,10 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     if kind == "simulate":
         kw["disturbance"] = disturbance(top.table("disturbance"), base, wing.span)
         ct = top.table("controller", required=True).check_keys(
-            ("spec",), ("engaged_speeds", "engaged_speed_factors", "flutter_margin")
+            ("spec",),
+            ("engaged_speeds", "engaged_speed_factors", "flutter_margin", "realisable"),
         )
+        kw["realisable"] = ct.boolean("realisable", False)
         spec_path = ct.path("spec", base, required=True)
         kw["controller"] = controller(ct, spec_path)
         engaged_speeds(ct, kw)

@@ -281,6 +281,8 @@ class GustLoadsResult:
     def summary_text(self) -> str:
         """A loads engineer's summary: worst limit load per load and loop, GLA, flags."""
         lines = [f"gust loads {self.name}: {len({r['point'] for r in self.records})} points"]
+        if self.settings.get("loop_measures"):
+            lines.append(f"  the closed loop feeds back {self.settings['loop_measures']}")
         for loop in self.loops:
             w = self.worst(loop)
             lines.append(f"  {loop} loop, worst limit load (incremental, clamped wing):")

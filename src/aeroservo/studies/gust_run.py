@@ -47,6 +47,20 @@ def _settings(study: GustLoadsStudy) -> dict:
     }
 
 
+def _measures(study: GustLoadsStudy) -> str | None:
+    """What the closed loop feeds back (issue 38: a state feedback is not realisable and
+    sees the gust states, a perfect gust measurement)."""
+    if study.controller is None:
+        return None
+    ctrl = design_point(study)[0]
+    if getattr(ctrl, "needs_state", False):
+        return (
+            "the plant state (state feedback): not realisable as built; it feeds back the gust "
+            "and aerodynamic lag states no sensor measures (a perfect gust measurement)"
+        )
+    return f"its sensors: {', '.join(study.sensors)}"
+
+
 def run_gust_loads(
     study: GustLoadsStudy,
     *,
@@ -104,6 +118,7 @@ def run_gust_loads(
         for d in pl.discrete.values():
             units.update(d.units)
     settings = _settings(study)
+    settings["loop_measures"] = _measures(study)
     settings["elapsed"] = time.perf_counter() - t0
     settings["skipped_points"] = skipped
     return GustLoadsResult(study.name, records, arrays, units, settings)

@@ -174,26 +174,23 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     loop = scenario.loop(model)
     spec = scenario.controller
     from ..design.interface import controller_at
+    from ..design.realisability import refuse_unrealisable
 
     controller = loop.design_controller(spec, speed, scenario.sample_rate, vf)
     at = controller_at(controller, speed)  # a schedule at the scenario's speed
     plant = loop.plant(speed)
+    if scenario.realisable:
+        refuse_unrealisable(scenario.source, plant, at)
     dist = scenario.disturbance
     x0 = loop.initial_state(dist.initial_tip) if dist.initial_tip else None
     noise = {k: np.sqrt(v) for k, v in scenario.sensor_noise.items()} or None
+    kw = {"limits": spec.limits, "delay": scenario.delay, "sensor_noise": noise}
     with warnings.catch_warnings():  # the summary gives the windup warning, once
         warnings.filterwarnings("ignore", message="simulate: the controller's commands run")
         result = simulate(
-            plant,
-            at,
-            duration=scenario.duration,
-            x0=x0,
-            disturbance=dist.gust,
-            limits=spec.limits,
-            delay=scenario.delay,
-            sensor_noise=noise,
-            seed=scenario.seed,
-        )
+            plant, at, duration=scenario.duration, x0=x0, disturbance=dist.gust,
+            seed=scenario.seed, **kw,
+        )  # fmt: skip
     open_loop = None
     if scenario.plots and not isinstance(controller, OpenLoop):  # overlay of the figure
         open_loop = simulate(
@@ -224,13 +221,9 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
         "rate_limited_fraction": result.rate_limited_fraction,
         "units": dict(result.units),
     }
-    for group in (result.outputs, result.applied):
-        for name, y in group.items():
-            summary["signals"][name] = {
-                "peak": float(np.abs(y).max()),
-                "rms": float(np.sqrt(np.mean(y**2))),
-                "growth": signal_growth(y),
-            }
+    for name, y in {**result.outputs, **result.applied}.items():
+        rms, growth = float(np.sqrt(np.mean(y**2))), signal_growth(y)
+        summary["signals"][name] = {"peak": float(np.abs(y).max()), "rms": rms, "growth": growth}
     sat, rl = summary["saturated_fraction"], summary["rate_limited_fraction"]
     limited = {c: max(sat[c], rl[c]) for c in sat}
     summary.update(loop_verdict(plant, at, scenario.delay, summary["signals"], limited))

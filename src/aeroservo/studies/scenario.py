@@ -77,6 +77,7 @@ class Scenario:
     v_max: float | None = None
     pk: bool = False
     sol145: dict | None = None  # a Nastran flutter case's velocities (files/scenario_tables)
+    realisable: bool = False  # refuse a law on states no sensor measures ([controller])
     controls: tuple = ()
     sensors: tuple = ()
     outputs: tuple = ()

@@ -95,12 +95,20 @@ def loop_verdict(
     -------
     dict
         ``verdict`` ("stable" or "unstable"), ``spectral_radius``, ``growth_rate`` [1/s] and
-        ``critical_frequency`` [Hz] of its largest eigenvalue, ``growing_signals`` and, when
-        unstable, a one-line ``hint``.
+        ``critical_frequency`` [Hz] of its largest eigenvalue, ``growing_signals``, when
+        unstable a one-line ``hint``; ``realisable`` and ``unmeasured_feedback`` (the plant
+        states by kind that a state-feedback law feeds back directly, with a ``warnings``
+        line: :mod:`aeroservo.design.realisability`).
     """
     from ..design.closed_loop import closed_loop_matrix
     from ..design.interface import has_linear_law
+    from ..design.realisability import realisability_text, unmeasured_feedback
     from ..design.sampled_loop import linear_law, plant_states
+
+    unmeasured = unmeasured_feedback(plant, controller)
+    realisable = {"realisable": not unmeasured, "unmeasured_feedback": unmeasured}
+    if unmeasured:
+        realisable["warnings"] = [realisability_text(unmeasured)]
 
     growing = sorted(n for n, v in signals.items() if np.nan_to_num(v["growth"]) > GROWS)
     if not has_linear_law(controller):
@@ -115,7 +123,7 @@ def loop_verdict(
             out["hint"] = (
                 f"closed loop unstable: {', '.join(growing)} grow under the nonlinear controller"
             )
-        return out
+        return out | realisable
     A, dt = closed_loop_matrix(plant, controller, delay=delay)
     lam = np.linalg.eigvals(A)
     i = int(np.argmax(np.abs(lam)))
@@ -148,4 +156,4 @@ def loop_verdict(
             share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in busy.items())
             hint += f" (at its limits: {share} of the samples; the limits bound the response)"
         out["hint"] = hint
-    return out
+    return out | realisable
