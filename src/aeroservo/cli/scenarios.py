@@ -108,9 +108,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(json_text(summary))
     else:
         print(_readable(summary))
-    # the text report lists its warnings; with --json they go to stderr (once either way)
-    for w in summary.get("warnings", []) if scenario.kind == "simulate" and args.json else []:
-        print(f"aeroservo: warning: {w}", file=sys.stderr)
+    # a run's warnings are in its report (the text's "warning:" lines, the JSON's "warnings"),
+    # once: stderr keeps the one line of a failed verdict
     if summary.get("passed") is False and not scenario.expect_failure:
         from ..studies.verdict import EXIT_UNSTABLE
 

@@ -158,7 +158,9 @@ def analyse_loop(
     if not has_linear_law(controller):
         res.judgement = _simulated(scenario, loop, controller, engaged, x0, bar)
         return res
-    res.margins = loop_margins(plant, controller, delay=scenario.delay, requirement=spec.margins)
+    res.margins = loop_margins(
+        plant, controller, delay=scenario.delay, requirement=spec.margins, outputs=True
+    )
     if scenario.closed_loop_boundary:
         v_top = max(scenario.v_max_factor * (flutter_speed or speed), engaged.stable_to)
         update, close = bar(v_top, "closed-loop sweep")
