@@ -263,7 +263,7 @@ def test_requirement_at_every_break_point(lqg_loop):
 def test_simultaneous_disk_margin_at_the_sensors(lqg_loop):
     """The disk margin at all sensors at once (issue 38) against the loop closed in the test
     with independent gain-phase changes f_j = (2 + d_j) / (2 - d_j), |d_j| < alpha, at every
-    sensor (random phases, 300 draws): stable; and it is at most each sensor's own disk margin
+    sensor (random phases, 100 draws): stable; and it is at most each sensor's own disk margin
     (a perturbation of one sensor is one of the simultaneous ones). Measured: alpha = 0.127
     (+-1.1 dB, +-7.3 deg) at 58 Hz, against 0.26-0.76 one sensor at a time."""
     plant, ctrl = lqg_loop
@@ -276,7 +276,7 @@ def test_simultaneous_disk_margin_at_the_sensors(lqg_loop):
 
     A, B, C = LoopBlocks(sp, law).at_sensors()
     rng = np.random.default_rng(38)
-    for _ in range(300):
+    for _ in range(100):
         d = 0.999 * alpha * np.exp(1j * rng.uniform(0, 2 * np.pi, B.shape[1]))
         f = (2 + d) / (2 - d)
         assert rho(A + B @ np.diag(f) @ C) < 1.0
