@@ -98,6 +98,11 @@ def test_gradient_range_and_tas():
     assert GRADIENT_RANGE == pytest.approx((9.144, 106.68))
     with pytest.raises(InputError, match="gradient"):
         design_gust_velocity(8.0, 0.0, 1.0)
+    with pytest.raises(InputError, match="gradient"):
+        design_gust_velocity(110.0, 0.0, 1.0)
+    # issue 38: 9 m and 107 m, the rule's 30 ft and 350 ft as the field rounds them, are its ends
+    for h, end in ((9.0, 30.0), (107.0, 350.0)):
+        assert design_gust_velocity(h, 0.0, 1.0) == design_gust_velocity(end * FT, 0.0, 1.0)
     assert gust_tas(10.0, 0.0) == pytest.approx(10.0)
     # ISA at 10 000 m geopotential (pressure altitude): 223.15 K, 26 436 Pa, 0.41271 kg/m^3
     rho = 26436.0 / (287.053 * 223.15)

@@ -43,6 +43,11 @@ U_REF_TABLE = (
 """(altitude [m], U_ref [m/s EAS]) of 25.341(a)(5)(i), linear between the rows."""
 GRADIENT_RANGE = (30.0 * FT, 350.0 * FT)
 """Gust gradient distances H [m] the rule searches: 30 ft to 350 ft (9.144 m to 106.68 m)."""
+
+GRADIENT_ROUNDING = 0.02
+"""Relative tolerance at the ends of :data:`GRADIENT_RANGE`: the field's usual metric values
+9 m and 107 m (30 ft and 350 ft rounded) are taken as the ends (a value within 2 % outside
+them is the end itself)."""
 Z_REF = 250000.0 * FT
 """The 250 000 ft of F_gz [m]."""
 
@@ -116,9 +121,15 @@ def design_gust_velocity(
     at_vd : bool
         Halve U_ref (design dive speed).
     """
+    lo, hi = GRADIENT_RANGE
     h_g = check_number(
-        "gust gradient H", gradient, unit="m", lo=GRADIENT_RANGE[0], hi=GRADIENT_RANGE[1]
+        "gust gradient H",
+        gradient,
+        unit="m",
+        lo=lo * (1 - GRADIENT_ROUNDING),
+        hi=hi * (1 + GRADIENT_ROUNDING),
     )
+    h_g = min(max(h_g, lo), hi)  # 9 m and 107 m: the rule's 30 ft and 350 ft, rounded
     f_g = check_number("f_g", f_g, lo=0.0, lo_open=True, hi=1.0)
     u_ref = reference_gust_velocity(altitude, at_vd=at_vd)
     return u_ref * f_g * (h_g / GRADIENT_RANGE[1]) ** (1.0 / 6.0)
