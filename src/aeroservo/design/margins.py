@@ -108,9 +108,7 @@ class LoopMargins:
         out = []
         if "inputs" in req.at:
             out += [v for ch in self.channels.values() for v in ch.violations(req)]
-        if "sensors" in req.at:
-            if not self.sensors and self.channels:
-                out.append("sensors: not analysed (the margins were computed without them)")
+        if "sensors" in req.at:  # loop_margins breaks at every sensor when they are judged
             out += [f"sensor {v}" for ch in self.sensors.values() for v in ch.violations(req)]
         disk = self.multiloop.get("disk_margin")
         alpha = req.disk_alpha
@@ -319,7 +317,7 @@ def loop_margins(
         False (default): the controller is a black box from sensors to commands; True: the
         applied input is measured and fed to its estimator (see the module docstring).
     sensors : bool
-        Also break the loop at each sensor.
+        Also break the loop at each sensor (always when the requirement judges them).
     outputs : bool, optional
         Also the simultaneous disk margin at all sensors at once (mu over frequency: about
         0.7 s for three sensors of the shipped LQG). Default: when the requirement judges
@@ -349,6 +347,7 @@ def loop_margins(
         channels[name] = channel_margins(Aj, B[:, [j]], C[[j]], name, law.dt)
     req = requirement or MarginRequirement()
     want_outputs = "multiloop" in req.at if outputs is None else bool(outputs)
+    sensors = sensors or "sensors" in req.at
     at_sensors, multi_out = {}, {}
     if sensors:
         for j, name in enumerate(law.sensors):

@@ -207,7 +207,10 @@ def _frequencies(wing: Wing, n_elements: int, aero) -> list[float]:
         return []
     from ..system.aeroelastic import AeroelasticModel
 
-    model = AeroelasticModel(wing, max(n_elements, 2) if n_elements <= 300 else 300)
+    try:  # one element per CBAR, unless the companion's surfaces need more breakpoints
+        model = AeroelasticModel(wing, min(max(n_elements, 2), 300))
+    except InputError:
+        model = AeroelasticModel(wing, 300)
     n = min(aero.lmodes or 3, model.n_dofs)
     return list(model.natural_modes(n).frequencies)
 
