@@ -214,3 +214,26 @@ def test_a_state_feedback_object_acts_in_the_design_points_basis():
     obj = _study(controller=ctrl, limits=sc.controller.limits, **kw)
     a, b = run_gust_loads(spec).table, run_gust_loads(obj).table
     assert np.allclose(a["discrete_max"], b["discrete_max"], rtol=1e-9)
+
+
+def test_swept_wing_under_strip_gusts_says_the_spanwise_delay_is_missing():
+    """Issue 38: the strip model's gust reaches every strip at once; on a swept wing the
+    report says the spanwise delay is left out (and a straight wing's report does not)."""
+    swept = aes.examples.goland_swept(np.deg2rad(30.0))
+    res = run_gust_loads(
+        _study(
+            controller=None,
+            controls=(),
+            sensors=(),
+            mass_cases={"nominal": aes.examples.goland_aileron(), "swept": swept},
+            points=(
+                FlightPoint(0.0, 100.0, "V_C", "nominal"),
+                FlightPoint(0.0, 100.0, "V_C", "swept"),
+            ),
+        )
+    )
+    (w,) = res.settings["warnings"]
+    assert w.startswith("mass case swept: a swept wing") and "spanwise delay" in w
+    assert f"WARNING: {w}" in res.summary_text()
+    straight = run_gust_loads(_study(controller=None, controls=(), sensors=()))
+    assert straight.settings["warnings"] == []

@@ -307,7 +307,7 @@ class GustLoadsResult:
         for sk in self.settings.get("skipped_points", []):
             why = "; ".join(sk["notes"]) or "no loop computed"
             lines.append(f"  NO LOADS at point {sk['point']} ({sk['flight_point']}): {why}")
-        for line in self.raised_loads():
+        for line in self.raised_loads() + list(self.settings.get("warnings", [])):
             lines.append(f"  WARNING: {line}")
         return "\n".join(lines)
 
