@@ -74,7 +74,8 @@ class FlutterCase:
     velocities: tuple[float, ...]  # [m/s], PK methods
     reduced_frequencies: tuple[float, ...]  # K and KE methods
     imeth: str
-    cards: str  # "FLUTTER 30 (FLFACT 1, 2, 4)"
+    cards: str  # "FLUTTER 30 (PK; FLFACT 1, 2, 4)"
+    density_fact: int | None = None  # the FLFACT of its density ratios
 
 
 @dataclass(frozen=True)
@@ -151,7 +152,7 @@ def _flutter_case(path: Path, model, units: UnitSystem, notes: list) -> FlutterC
     ids = ", ".join(str(x) for x in (card.density, card.mach, card.reduced_freq_velocity))
     return FlutterCase(
         card.sid, method, dens, machs, vel, ks, str(card.imethod or "L"),
-        f"{where} ({method}; FLFACT {ids})",
+        f"{where} ({method}; FLFACT {ids})", card.density,
     )  # fmt: skip
 
 
@@ -159,9 +160,7 @@ def _panels(path: Path, model, units: UnitSystem, notes: list) -> tuple[Panel, .
     panels = []
     for eid, caero in sorted(model.caeros.items()):
         where = f"{path}: CAERO1 {eid}"
-        paero = model.paeros.get(caero.pid)
-        if paero is None:
-            raise InputError(f"{where}: PAERO1 {caero.pid} is missing")
+        paero = model.paeros[caero.pid]  # present: check_aero_references
         if any(getattr(paero, "caero_body_ids", None) or []):
             notes.append(f"PAERO1 {caero.pid}: its bodies are left out (no body aerodynamics)")
         p1, p2, p3, p4 = (np.asarray(p, dtype=float) * units.length for p in caero.get_points())
@@ -184,9 +183,7 @@ def _splines(path: Path, model, panels: tuple[Panel, ...]) -> tuple:
     by_eid = {p.eid: p for p in panels}
     for eid, sp in sorted(model.splines.items()):
         where = f"{path}: {sp.type} {eid}"
-        if sp.caero not in by_eid:
-            raise InputError(f"{where}: CAERO1 {sp.caero} is missing")
-        panel = by_eid[sp.caero]
+        panel = by_eid[sp.caero]  # its CAERO1, SET1 and grids exist: check_aero_references
         for key in ("box1", "box2"):
             if panel.box(int(getattr(sp, key))) is None:
                 last = panel.eid + panel.nspan * panel.nchord - 1
@@ -194,15 +191,9 @@ def _splines(path: Path, model, panels: tuple[Panel, ...]) -> tuple:
                     f"{where}: {key.upper()} = {getattr(sp, key)} is not a box of CAERO1 "
                     f"{panel.eid} (boxes {panel.eid} to {last})"
                 )
-        setg = model.sets.get(sp.setg)
-        if setg is None:
-            raise InputError(f"{where}: SETG = {sp.setg}: SET1 {sp.setg} is missing")
-        grids = tuple(int(g) for g in setg.ids)
+        grids = tuple(int(g) for g in model.sets[sp.setg].ids)
         if not grids:
             raise InputError(f"{where}: SET1 {sp.setg} has no points: the spline carries nothing")
-        missing = [g for g in grids if g not in model.nodes]
-        if missing:
-            raise InputError(f"{where}: SET1 {sp.setg}: GRID {missing[0]} is missing")
         out.append((sp.type, int(eid), int(sp.caero), grids))
     return tuple(out)
 
@@ -213,10 +204,7 @@ def _surfaces(path: Path, model, panels) -> tuple:
         where = f"{path}: AESURF {surf.aesid} ({surf.label})"
         if surf.alid2:
             raise InputError(f"{where}: a second hinge line (CID2, ALID2) is not modelled")
-        lst = model.aelists.get(surf.alid1)
-        if lst is None:
-            raise InputError(f"{where}: AELIST {surf.alid1} is missing")
-        boxes = tuple(int(b) for b in lst.elements)
+        boxes = tuple(int(b) for b in model.aelists[surf.alid1].elements)  # present, as above
         stray = [b for b in boxes if not any(p.box(b) is not None for p in panels)]
         if stray:
             raise InputError(f"{where}: AELIST {surf.alid1}: box {stray[0]} is on no CAERO1")
@@ -262,7 +250,7 @@ def aero_deck(path: Path, model, units: UnitSystem) -> AeroDeck | None:
         )
     param = model.params.get("LMODES")
     ratio = flutter.density_ratios[0] if flutter and flutter.density_ratios else 1.0
-    card = f"FLFACT {flutter.cards.split('FLFACT ')[1].split(',')[0]}" if flutter else "AERO"
+    card = f"FLFACT {flutter.density_fact}" if flutter else "AERO"
     return AeroDeck(
         flow=flow,
         ref_chord=float(refc) * units.length if refc else None,

@@ -260,7 +260,7 @@ def scenario_text(
         f"# The flutter case of {deck.name} ({fc.cards}), written by 'aeroservo import nastran'.",
         f"# Run: aeroservo flutter {Path(wing_file).stem}_flutter.toml (docs/nastran.md).",
         "[scenario]",
-        f'name = "{name}: {fc.cards.split(" (")[0]} ({fc.method})"',
+        f'name = "{name}: FLUTTER {fc.sid} ({fc.method})"',
         'kind = "flutter"',
         "",
         "[wing]",

@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, check_number, check_quantity
+from .nastran_deck import vector_text
 from .toml_tables import read_toml
 
 __all__ = ["ImportOptions", "SpanValues", "import_options", "VALUE_KEYS"]
@@ -104,10 +105,6 @@ def _values(where: str, tbl: Mapping) -> dict[str, float]:
     if "mass" in tbl:
         out["mass"] = check_quantity(f"{where}.mass", tbl["mass"], "mass_per_length")
     return out
-
-
-def _text(v) -> str:
-    return "[" + ", ".join(f"{float(x):.6g}" for x in v) + "]"
 
 
 def _unit_vector(where: str, value: object) -> np.ndarray:
@@ -208,7 +205,7 @@ def import_options(
     opts = ImportOptions(defaults=defaults, sections=tuple(sections), **kw)
     if abs(float(opts.free_stream @ opts.up)) > 1.0 - 1e-6:
         raise InputError(
-            f"free_stream = {_text(opts.free_stream)} is along up = {_text(opts.up)}: the flow "
-            "must lie in the wing's plane"
+            f"free_stream = {vector_text(opts.free_stream)} is along up = "
+            f"{vector_text(opts.up)}: the flow must lie in the wing's plane"
         )
     return opts
