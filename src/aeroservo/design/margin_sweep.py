@@ -134,13 +134,8 @@ def margins_over_speed(
     out: list[LoopMargins] = []
     for s in v:  # loop_margins evaluates a schedule at the plant's speed
         out.append(
-            loop_margins(
-                at(float(s)),
-                controller,
-                delay=delay,
-                requirement=req,
-                sensors="sensors" in req.at,
-            )
+            # loop_margins breaks at the sensors when the requirement judges them
+            loop_margins(at(float(s)), controller, delay=delay, requirement=req, sensors=False)
         )
 
         if progress is not None:
