@@ -665,3 +665,45 @@ def test_frequency_check_names_the_units(tmp_path):
     with pytest.raises(InputError, match="read as in-lbf-s .* companion values are SI") as info:
         read_nastran(SAMPLE, units="in-lbf-s", companion=comp)
     assert "\n" not in str(info.value) and "torsion frequency" in str(info.value)
+
+
+def test_imported_rotary_inertias_in_the_planform_and_sensitivities(tmp_path):
+    """Review finding: the sample's CMASS2 rotary inertias (mass 0) broke the planform figure
+    (a division by the largest mass) and the doublet lattice's finite-difference
+    sensitivities (a tip station stepped beyond the tip). The tip station is now differenced
+    inward, to first order, and listed as one-sided; its derivative agrees with a step of
+    twice the size (checked here) to 5 %."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from aeroservo.plots.planform import plot_planform
+    from aeroservo.stability.sensitivity import flutter_sensitivities
+
+    run = _cli(
+        "import", "nastran", str(SAMPLE), "--units", "in-lbf-s", "--out", "w.toml", cwd=tmp_path
+    )
+    assert run.returncode == 0, run.stderr
+    wing, opts = load_wing(tmp_path / "w.toml")
+    fig = plot_planform(wing)
+    labels = fig.axes[0].get_legend_handles_labels()[1]
+    assert "rotary inertia (no mass)" in labels and "concentrated mass (CG)" not in labels
+    model = AeroelasticModel(wing, 10, aero=opts.aero)
+    name = f"masses[{len(wing.masses) - 1}].station"
+    s = flutter_sensitivities(model, opts.density, [name], mach=opts.mach, v_max=opts.v_max)
+    assert name in s.one_sided and name not in s.undefined
+    d = s.d_flutter_speed[name]
+    from dataclasses import replace
+
+    from aeroservo.stability.sensitivity_fd import STEP
+
+    h = 2 * STEP * wing.span
+    moved = replace(wing.masses[-1], station=wing.span - h)
+    far = AeroelasticModel(replace(wing, masses=(*wing.masses[:-1], moved)), 10, aero=opts.aero)
+    v_far = aes_boundary(far, opts).flutter_speed
+    assert d == pytest.approx((s.flutter_speed - v_far) / h, rel=0.05)
+
+
+def aes_boundary(model, opts):
+    from aeroservo.stability.boundary import flutter_boundary
+
+    return flutter_boundary(model, opts.density, mach=opts.mach, v_max=opts.v_max, rtol=1e-10)

@@ -123,15 +123,20 @@ def plot_planform(wing, *, title: str | None = None, lattice=None) -> Figure:
             if m.surface is not None:
                 y += seg.semichord * (wing.surface(m.surface).hinge - seg.a)
             p = planform_points(wing, m.station, y)[0]
-            ax.scatter(p[1], p[0], s=40 + 260 * m.mass / top, color="C3", ec="k", zorder=5)
+            size = 40 + 260 * m.mass / top if top > 0 else 40
+            rotary = m.mass == 0.0  # a rotary inertia (no mass): a hollow marker
+            ax.scatter(p[1], p[0], s=size, color="none" if rotary else "C3", ec="k", zorder=5)
             ax.annotate(
-                f"{m.name} {m.mass:g} kg",
+                f"{m.name} {m.inertia:.3g} kg m^2" if rotary else f"{m.name} {m.mass:g} kg",
                 (p[1], p[0]),
                 xytext=(6, 6),
                 textcoords="offset points",
                 fontsize=8,
             )
-        ax.scatter([], [], s=60, color="C3", ec="k", label="concentrated mass (CG)")
+        if top > 0:
+            ax.scatter([], [], s=60, color="C3", ec="k", label="concentrated mass (CG)")
+        if any(m.mass == 0.0 for m in masses):
+            ax.scatter([], [], s=40, color="none", ec="k", label="rotary inertia (no mass)")
     if lattice is not None:
         _draw_lattice(ax, lattice)
     ax.set_aspect("equal")

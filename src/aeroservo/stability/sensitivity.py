@@ -90,6 +90,7 @@ class FlutterSensitivities:
     d_divergence_speed: dict = field(default_factory=dict)
     non_differentiable: str | None = None
     undefined: dict = field(default_factory=dict)
+    one_sided: dict = field(default_factory=dict)
     density: float = 1.225
     altitude: float | None = None
     mach: float = 0.0
@@ -114,6 +115,7 @@ class FlutterSensitivities:
             "method": self.method,
             "non_differentiable": self.non_differentiable,
             "undefined": dict(self.undefined),
+            "one_sided": dict(self.one_sided),
             "values": dict(self.values),
             "d_flutter_speed": dict(self.d_flutter_speed),
             "d_flutter_frequency": dict(self.d_flutter_frequency),

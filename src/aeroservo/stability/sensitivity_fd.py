@@ -12,13 +12,16 @@ and divergence speeds are found to ``rtol``:
 with ``scale`` the parameter's natural size (a semichord, the span, ...) for parameters whose
 value may be zero. The error is ``O(h^2)`` plus ``rtol V / h``. A derivative whose two sides
 find different crossings (another mode goes unstable first, or the speed vanishes) is listed as
-undefined with its one-sided values, as the analytic derivatives are.
+undefined with its one-sided values, as the analytic derivatives are. A parameter at a bound of
+its allowed range (a mass at the tip, a rotary inertia's zero mass) is differenced on the side
+that stays inside, to first order, and listed in ``one_sided``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..system.damping import StructuralDamping, damping_parameters
 
 __all__ = ["finite_differences", "STEP"]
@@ -103,7 +106,18 @@ def finite_differences(model, result, out, table: dict, atmosphere, compressibil
         if h == 0.0:
             out.undefined[name] = "zero value without a natural scale: no step to take"
             continue
-        sides = [analysis(name, p + s * h) for s in (1.0, -1.0)]
+        sides = []
+        for sign in (1.0, -1.0):
+            try:
+                sides.append(analysis(name, p + sign * h))
+            except InputError:  # a bound of the parameter: a mass at the tip, a zero mass
+                sides.append(None)
+        if sides[0] is None and sides[1] is None:
+            out.undefined[name] = "both sides of the step leave the parameter's allowed range"
+            continue
+        if None in sides:
+            side = "upper" if sides[1] is None else "lower"
+            out.one_sided[name] = f"the {side} side only (the other leaves the allowed range)"
         for what, target, get in (
             ("flutter speed", out.d_flutter_speed, lambda r: r.flutter_speed),
             ("flutter frequency", out.d_flutter_frequency, lambda r: r.flutter_frequency),
@@ -111,6 +125,12 @@ def finite_differences(model, result, out, table: dict, atmosphere, compressibil
         ):
             v0 = get(result)
             if v0 is None or (what != "divergence speed" and out.non_differentiable):
+                continue
+            if None in sides:  # one-sided, first order
+                r = sides[0] if sides[1] is None else sides[1]
+                v = get(r)
+                if v is not None:
+                    target[name] = (v - v0) / h if sides[1] is None else (v0 - v) / h
                 continue
             hi, lo = (get(r) for r in sides)
             same = what == "divergence speed" or all(

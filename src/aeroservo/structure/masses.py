@@ -34,8 +34,8 @@ class ConcentratedMass:
         Spanwise position along the elastic axis [m], 0 < station <= span (need not be a
         mesh node).
     mass : float
-        Mass [kg], >= 0 (0: a pure rotary inertia, which then needs ``inertia`` > 0 and no
-        offsets).
+        Mass [kg], >= 0 (0: a pure rotary inertia, which then needs ``inertia`` > 0; its
+        offsets then carry no mass and change nothing).
     offset : float
         Chordwise position of its CG [m], positive aft, from the elastic axis (from the hinge
         line when ``surface`` is given: a balance weight ahead of the hinge has offset < 0).
@@ -73,8 +73,6 @@ class ConcentratedMass:
         )
         if self.mass == 0.0 and not (self.inertia > 0.0):
             raise InputError(f"{n}.mass = 0: a mass of 0 needs inertia > 0 (a rotary inertia)")
-        if self.mass == 0.0 and (self.offset or self.vertical_offset):
-            raise InputError(f"{n}.offset: a mass of 0 (a rotary inertia) has no CG to offset")
         if self.surface is not None and not isinstance(self.surface, str):
             raise InputError(
                 f"{n}.surface = {self.surface!r}: expected the name of a control surface"
