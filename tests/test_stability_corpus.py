@@ -1,9 +1,11 @@
 """The stability engine against an independent reference on a seeded, randomized corpus.
 
-The corpus (:mod:`wing_corpus`) holds wings of eleven classes: multi-segment wings with strong
+The corpus (:mod:`wing_corpus`) holds wings of thirteen classes: multi-segment wings with strong
 property jumps, HALE wings, one or two control surfaces (soft and stiff hinges, actuators off the
 mesh nodes), CG ahead of the EA, EA ahead of the quarter chord, divergence before flutter,
-nearly coincident bending and torsion frequencies and hump modes.
+nearly coincident bending and torsion frequencies, hump modes, and (issue 40) flutter onsets
+0.2-0.9 % above a divergence speed with a store ahead of or behind the axis, and tip stores ahead
+of the axis whose first onset is a higher mode near divergence (the class the engine missed).
 
 The reference uses nothing of :mod:`aeroservo.stability`: at each speed it takes the dense state
 matrix ``model.state_matrix(V, density)`` and all of its eigenvalues (``scipy.linalg.eigvals``),
@@ -379,3 +381,44 @@ def test_pk_agrees_with_time_domain(index: int) -> None:
             f"{case.name}: p-k flutter {v_pk:.9g} m/s, time domain ({name}) {v_td:.9g} m/s, "
             f"rel. diff {_rel(v_pk, v_td):.4f} > {PK_RTOL[name]}\n  reproducer: {reproducer(case)}"
         )
+
+
+# Issue 40, item 1: the Goland wing with a 65.3 kg tip store (30 % of the wing's mass, 2.18 kg m^2)
+# 0.3 semichords ahead of the elastic axis, 40 elements, R.T. Jones, sea level. It diverges at
+# 252.68 m/s and its 2nd bending (41.3 Hz, above the modal band of 3 x the first torsion)
+# flutters at 253.19 m/s. The engine reported only the divergence for search limits of
+# 260-350 m/s (the default 303 m/s included) and found the onset with 400 m/s.
+
+
+@functools.cache
+def _issue40_model() -> aes.AeroelasticModel:
+    base = aes.examples.goland()
+    b = base.segments[0].semichord
+    store = aes.ConcentratedMass(
+        station=base.span, mass=65.3, offset=-0.3 * b, inertia=2.18, name="store"
+    )
+    wing = aes.Wing(base.span, base.segments, masses=[store], name="Goland + tip store ahead")
+    return aes.AeroelasticModel(wing, n_elements=40, wagner="rt_jones")
+
+
+@pytest.mark.parametrize("v_max", [None, 260.0, 350.0, 400.0])
+def test_issue40_onset_just_above_divergence(v_max) -> None:
+    model = _issue40_model()
+    result = aes.flutter_boundary(model, 1.225, v_max=v_max)
+
+    # independent: the dense state matrix on both sides of the crossing, no branch followed
+    def g(v: float) -> complex:
+        lam = sla.eigvals(model.state_matrix(v, 1.225))
+        osc = lam[(lam.imag > OSC * np.abs(lam)) & (np.abs(lam) > 1e-9)]
+        return complex(osc[np.argmax(osc.real)])
+
+    v_f = brentq(lambda v: g(v).real, 252.9, 254.0, xtol=1e-9 * 254.0)
+    assert g(252.9).real < 0 < g(254.0).real
+    assert result.divergence_speed == pytest.approx(252.677, rel=1e-4)
+    assert result.flutter_speed is not None, result.warnings
+    assert _rel(result.flutter_speed, v_f) <= 1e-5
+    onset = next(c for c in result.crossings if c.kind == "onset")
+    assert onset.frequency == pytest.approx(abs(g(v_f * 1.0001).imag) / (2 * np.pi), rel=1e-3)
+    assert onset.frequency == pytest.approx(41.3, abs=0.1)
+    if v_max != 400.0:  # at 400 m/s the truncation check already widens the band
+        assert any("above the band" in w for w in result.warnings), result.warnings

@@ -63,6 +63,8 @@ CLASSES = {
     "divergence_critical": 4,
     "near_coincident": 4,
     "hump": 3,
+    "near_divergence": 4,
+    "tip_store": 4,
 }
 """Number of cases per class."""
 
@@ -91,6 +93,7 @@ class Draw:
     wing: aes.Wing
     density: float
     n_elements: int
+    target: float | None = None  # the instability the class is about [m/s], if known
 
 
 # --------------------------------------------------------------------------------------------
@@ -414,6 +417,134 @@ def _draw_hump(rng: np.random.Generator, k: int) -> Draw:
     return Draw(wing, _u(rng, 0.3, 0.6), _n_elements(rng))
 
 
+# instabilities within 1 % above divergence (issue 40): a store tuned in mass
+
+
+def _eigs(model: aes.AeroelasticModel, density: float, v: float) -> tuple[np.ndarray, np.ndarray]:
+    """Oscillatory eigenvalues (Im > 0) and real ones of the dense state matrix at speed v."""
+    lam = sla.eigvals(model.state_matrix(v, density))
+    mag = np.abs(lam)
+    return lam[(lam.imag > 1e-6 * mag) & (mag > 1e-9)], lam[np.abs(lam.imag) <= 1e-6 * mag].real
+
+
+def _first_root(g: Callable[[float], float], v_top: float, n: int = 40) -> float | None:
+    """First speed on (0, v_top] where ``g`` turns positive (grid of n, then brentq)."""
+    from scipy.optimize import brentq
+
+    speeds = np.linspace(v_top / n, v_top, n)
+    prev = g(speeds[0])
+    for lo, hi in zip(speeds[:-1], speeds[1:], strict=True):
+        cur = g(hi)
+        if prev < 0 <= cur:
+            return float(brentq(g, lo, hi, xtol=1e-10 * hi))
+        prev = cur
+    return None
+
+
+def _max_re(model: aes.AeroelasticModel, density: float, real: bool) -> Callable:
+    def g(v: float) -> float:
+        osc, re = _eigs(model, density, v)
+        vals = re if real else osc.real
+        return float(vals.max()) if vals.size else -1e300
+
+    return g
+
+
+def _with_store(draw: Draw, store: dict, mass: float) -> aes.AeroelasticModel:
+    wing = aes.Wing(
+        draw.wing.span,
+        draw.wing.segments,
+        masses=[aes.ConcentratedMass(mass=mass, inertia=mass * store["r2"], **store["at"])],
+        name=draw.wing.name,
+    )
+    return aes.AeroelasticModel(wing, n_elements=draw.n_elements)
+
+
+def _higher_mode(model: aes.AeroelasticModel, density: float, v: float) -> bool:
+    """The mode unstable just above ``v`` [m/s] oscillates above 3 x the first torsion
+    frequency (a higher mode, as the 2nd bending of the issue's wing at 41.3 Hz)."""
+    osc, _ = _eigs(model, density, v * 1.001)
+    lam = osc[np.argmax(osc.real)]
+    return bool(abs(lam.imag) / (2 * np.pi) > 3.0 * _first_torsion_hz(model))
+
+
+def _draw_tip_store(rng: np.random.Generator, k: int) -> Draw:
+    """The issue-40 wing, randomized: a Goland-like wing with a tip store of 25-40 % of its mass
+    0.2-0.35 semichords ahead of the axis (radius of gyration 0.15-0.25 semichords), kept when
+    its first onset is that of a higher mode (above 3 x the first torsion frequency, as the
+    41.3 Hz 2nd bending of the issue) between 0.97 and 1.15 x the divergence speed."""
+    s = _goland_section(rng, spread=0.1)
+    b = s["semichord"]
+    mass = _u(rng, 0.25, 0.4) * s["mass"] * GOLAND_SPAN
+    at = {"station": GOLAND_SPAN, "offset": -_u(rng, 0.2, 0.35) * b, "name": "store"}
+    store = {"at": at, "r2": (_u(rng, 0.15, 0.25) * b) ** 2}
+    seg = _segment(0.0, GOLAND_SPAN, s, "goland")
+    draw = Draw(
+        aes.Wing(GOLAND_SPAN, [seg], name="tip store ahead"),
+        _u(rng, 0.9, 1.225),
+        int(rng.integers(10, 21)),
+    )
+    model = _with_store(draw, store, mass)
+    v_d = _first_root(_max_re(model, draw.density, True), 3000.0, 60)
+    if v_d is None:
+        raise aes.InputError("no divergence: redraw")
+    v_f = _first_root(_max_re(model, draw.density, False), 1.15 * v_d)
+    if v_f is None or v_f < 0.97 * v_d or not _higher_mode(model, draw.density, v_f):
+        raise aes.InputError("no higher-mode onset near divergence: redraw")
+    return Draw(model.wing, draw.density, draw.n_elements, target=v_d)
+
+
+def _draw_near_divergence(rng: np.random.Generator, k: int) -> Draw:
+    """A store ahead of the axis (k even: it raises a Goland-like wing's flutter to just above
+    its divergence) or behind it (k odd: it lowers the flutter of a divergence-first wing to
+    just above divergence), its mass tuned by bisection until the first flutter onset is
+    0.2-0.9 % above the static divergence speed (which the store's mass does not move)."""
+    ahead = k % 2 == 0
+    if ahead:
+        s = _goland_section(rng)
+    else:
+        s = _goland_section(rng, a=_u(rng, 0.0, 0.3), x_alpha=-_u(rng, 0.05, 0.2))
+    b = s["semichord"]
+    offset = (-1.0 if ahead else 1.0) * _u(rng, 0.2, 0.35) * b
+    at = {"station": _u(rng, 0.95, 1.0) * GOLAND_SPAN, "offset": offset, "name": "store"}
+    store = {"at": at, "r2": (_u(rng, 0.15, 0.25) * b) ** 2}
+    seg = _segment(0.0, GOLAND_SPAN, s, "goland")
+    draw = Draw(
+        aes.Wing(GOLAND_SPAN, [seg], name="store near divergence"),
+        _u(rng, 0.6, 1.225),
+        int(rng.integers(8, 11)),
+    )
+    v_d = _first_root(_max_re(_with_store(draw, store, 1.0), draw.density, True), 3000.0, 60)
+    if v_d is None:
+        raise aes.InputError("no divergence: redraw")
+    target = v_d * (1.0 + _u(rng, 0.002, 0.009))
+    wing_mass = s["mass"] * GOLAND_SPAN
+
+    def gap(mass: float) -> float:  # > 0: the first onset is above the target
+        model = _with_store(draw, store, mass)
+        v_f = _first_root(_max_re(model, draw.density, False), 1.02 * v_d)
+        return 1.0 if v_f is None else (v_f - target) / target
+
+    masses = np.linspace(0.1, 0.5, 8) * wing_mass
+    gaps = [gap(m) for m in masses]
+    for i in range(len(masses) - 1):
+        if (gaps[i] > 0) != (gaps[i + 1] > 0):
+            lo, hi = masses[i], masses[i + 1]
+            g_lo = gaps[i]
+            for _ in range(30):
+                mid = 0.5 * (lo + hi)
+                g_mid = gap(mid)
+                if abs(g_mid) < 2e-4:
+                    wing = _with_store(draw, store, mid).wing
+                    return Draw(wing, draw.density, draw.n_elements, target=v_d)
+                if (g_mid > 0) == (g_lo > 0):
+                    lo, g_lo = mid, g_mid
+                else:
+                    hi = mid
+            break  # a jump, not a crossing: redraw
+    raise aes.InputError("no store mass puts the onset just above divergence: redraw")
+
+
 DRAWS: dict[str, Callable[[np.random.Generator, int], Draw]] = {
     "multi_segment": _draw_multi_segment,
     "hale": _draw_hale,
@@ -426,6 +557,8 @@ DRAWS: dict[str, Callable[[np.random.Generator, int], Draw]] = {
     "divergence_critical": _draw_divergence_critical,
     "near_coincident": _draw_near_coincident,
     "hump": _draw_hump,
+    "near_divergence": _draw_near_divergence,
+    "tip_store": _draw_tip_store,
 }
 
 
@@ -494,6 +627,9 @@ def _case(rng: np.random.Generator, klass: str, k: int) -> Case:
             continue
         if klass == "actuators_only" and not _actuators_off_nodes(model):
             continue
+        if draw.target is not None:  # the range the issue-40 miss was in: 1.02-1.4 V_div
+            v_max = float(np.round(draw.target * _u(rng, 1.02, 1.4), 3))
+            return Case(case_name(klass, k), klass, model, float(draw.density), v_max)
         target = _target(klass, scan_events(model, draw.density, _v_top(model)))
         if target is None:
             continue

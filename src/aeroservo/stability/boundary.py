@@ -158,24 +158,27 @@ def flutter_boundary(
         top = float(br.speeds[-1])
         errors = _branch_errors(cert, br.eigenvalues.shape[1])
         band_top = 2 * np.pi * 1.1 * basis.cutoff if modal.basis is not None else np.inf
-        missing = list(cert.missing)
+        missing, above = list(cert.missing), None
         if cert.ok:
             try:
                 crossings = _crossings(ver, rtol, errors, band_top)
             except VerificationError as exc:
                 missing = [(exc.speed, exc.eigenvalue)]
+                above = str(exc) if exc.above_band else None
             except (RuntimeError, ValueError):
                 break  # not a missing mode: decided as far as possible below
         if crossings is not None or modal.basis is None or attempt == MAX_ENLARGE:
             break
         lost = max(abs(lam.imag) for _v, lam in missing) / (2 * np.pi)
         cutoff = max(1.5 * basis.cutoff, 1.3 * lost)
-        why = "certificate" if not cert.ok else "full model"
-        warnings.append(
+        why = "certificate" if not cert.ok else "full model" if above is None else "modal model"
+        found = (
             f"the {why} found a lightly damped mode near {lost:.4g} Hz that the modal model "
-            f"({basis.n_modes} modes, band up to {basis.cutoff:.4g} Hz) lacked or misplaced; "
-            f"swept again with the band up to {cutoff:.4g} Hz"
+            f"({basis.n_modes} modes, band up to {basis.cutoff:.4g} Hz) lacked or misplaced"
+            if above is None
+            else f"{above}, coupled with the modes in the band"
         )
+        warnings.append(f"{found}; swept again with the band up to {cutoff:.4g} Hz")
         n_before = basis.n_modes
         band_hz = cutoff
         basis = checked_basis(src, n_min, rho, v_max, mach, enlarged, cutoff)
@@ -183,7 +186,9 @@ def flutter_boundary(
             {
                 "by": why,
                 "modes": [n_before, basis.n_modes],
-                "reason": f"lightly damped mode near {lost:.4g} Hz missing or misplaced",
+                "reason": f"lightly damped mode near {lost:.4g} Hz missing or misplaced"
+                if above is None
+                else f"mode above the band near {lost:.4g} Hz nears the axis",
             }
         )
     if not cert.ok:
