@@ -175,7 +175,7 @@ def test_round_trip_is_equal(tmp_path):
     assert all(r["history"] == {} for r in bare.rows) and _same(bare.table(), res.table())
     with pytest.raises(InputError, match="expected a .json file name"):
         write_lco(res, tmp_path / "r.npz")
-    (tmp_path / "other.json").write_text('{"format": "aeroservo-gust-loads-1"}')
+    (tmp_path / "other.json").write_text('{"format": "aeroservo-gust-loads-2"}')
     with pytest.raises(InputError, match="not a valid aeroservo limit-cycle result"):
         load_lco(tmp_path / "other.json")
 

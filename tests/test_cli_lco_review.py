@@ -427,7 +427,7 @@ def test_plot_of_another_kind_and_without_npz(result_dir, tmp_path):
     """A gust-loads JSON is not read as limit cycles; without its NPZ a result redraws the
     bifurcation diagram only."""
     gust = tmp_path / "gust.json"
-    gust.write_text('{"format": "aeroservo-gust-loads-1"}')
+    gust.write_text('{"format": "aeroservo-gust-loads-2"}')
     code, _, err = _run(["plot", str(gust)])
     assert code == 2 and "not a valid aeroservo gust-loads result" in err
     (tmp_path / "x.json").write_bytes((result_dir / f"{STEM}.json").read_bytes())

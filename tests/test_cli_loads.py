@@ -21,7 +21,7 @@ from aeroservo.studies.scenario import quick
 
 EXAMPLE = ROOT / "scenarios" / "goland_aileron_gust_loads.toml"
 STEM = "goland_aileron_gust_loads"
-FIGURES = ("envelope", "correlated", "critical_gusts")
+FIGURES = ("envelope", "correlated", "critical_gusts", "spanwise")
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
@@ -64,13 +64,21 @@ def test_quick_settings():
         "tip_te_accel",
         "aileron_aero_hinge_moment",
         "aileron_deflection",
+        *(
+            f"{q}_at_{mm}mm"
+            for mm in (1219, 2438, 3658, 4877)
+            for q in ("shear", "bending_moment", "torque")
+        ),
     )
+    assert study.load_stations == (1.2192, 2.4384, 3.6576, 4.8768)
+    assert (study.v_c, study.v_d) == (100.0, 125.0)
 
 
 def test_loads_command_writes_the_set(cli_run):
     out, text = cli_run
     names = sorted(p.name for p in out.iterdir())
     expected = [f"{STEM}.csv", f"{STEM}.json", f"{STEM}.npz", f"{STEM}_alleviation.csv"]
+    expected += [f"{STEM}_histories.csv"]
     expected += [f"{STEM}_{f}.png" for f in FIGURES]
     assert names == sorted(expected)  # no temporary file left
     for f in FIGURES:
@@ -120,7 +128,23 @@ def test_round_trip_is_equal(api_run, tmp_path):
         "r.json",
         "r.npz",
         "r_alleviation.csv",
+        "r_histories.csv",
     ]
+    # the histories CSV holds the critical gusts as the NPZ does, 9 digits (issue 38)
+    hist = pd.read_csv(tmp_path / "r_histories.csv")
+    one = hist[(hist["point"] == 0) & (hist["loop"] == "closed")]
+    rb = res.record(0, "closed")["loads"]["root_bending_moment"]
+    crit = one[
+        np.isclose(one["gradient_m"], rb["max_gradient"], rtol=1e-6)
+        & (one["gust_sign"] == rb["max_sign"])
+    ]
+    t0, _g, y0 = res.history(0, "closed", "root_bending_moment")
+    np.testing.assert_allclose(crit["t_s"], t0, rtol=1e-6, atol=1e-9)
+    scale = np.abs(y0["root_bending_moment"]).max()
+    np.testing.assert_allclose(
+        crit["root_bending_moment"], y0["root_bending_moment"], rtol=0, atol=1e-6 * scale
+    )
+    assert crit["root_bending_moment"].max() == pytest.approx(rb["max"], rel=1e-4)
     back = load_gust_loads(tmp_path / "r.json")
     assert back.records == res.records and back.name == res.name
     assert back.units == res.units and back.settings == json.loads(json.dumps(res.settings))
@@ -325,7 +349,9 @@ def test_open_loop_scenario_with_mass_cases(tmp_path, capsys):
     assert summary["kind"] == "gust_loads" and summary["loops"] == ["open"]
     assert "records" not in summary and "alleviation_pct" not in summary
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted(["ol.json", "ol.npz", "ol.csv"] + [f"ol_{f}.png" for f in FIGURES])
+    files = ["ol.json", "ol.npz", "ol.csv", "ol_histories.csv"]
+    # no load stations: no spanwise figure
+    assert names == sorted(files + [f"ol_{f}.png" for f in FIGURES if f != "spanwise"])
     back = load_gust_loads(out / "ol.json")
     assert back.loops == ["open"]
     recs = {r["mass_case"]: r for r in back.records}

@@ -26,13 +26,8 @@ from aeroservo.design.interface import static_gain
 from aeroservo.design.law import pad_state_map
 from aeroservo.errors import InputError
 from aeroservo.files.scenario_file import load_scenario
-from aeroservo.studies.gust_loads import (
-    FlightPoint,
-    GustLoadsStudy,
-    design_point,
-    evaluate_point,
-    in_state_basis,
-)
+from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
+from aeroservo.studies.gust_point import design_point, evaluate_point, in_state_basis
 from aeroservo.studies.gust_results import RAISE_TOLERANCE
 from aeroservo.studies.gust_run import run_gust_loads
 from aeroservo.studies.tuned_gusts import tuned_gust_loads
@@ -237,3 +232,52 @@ def test_swept_wing_under_strip_gusts_says_the_spanwise_delay_is_missing():
     assert f"WARNING: {w}" in res.summary_text()
     straight = run_gust_loads(_study(controller=None, controls=(), sensors=()))
     assert straight.settings["warnings"] == []
+
+
+def test_the_command_applied_has_its_turbulence_a_bar():
+    """Issue 38: the actuator's hinge moment gets an A-bar like every load. With the static gain
+    u = -K tip_twist, the command at each sample is K times the sampled twist: its A-bar must be
+    K times the twist's (the same stationary process), which checks that the command row is the
+    command applied."""
+    st = _study(turbulence=True)
+    pl = evaluate_point(st, st.points[0])
+    ab = pl.turbulence["closed"].a_bar
+    assert ab[CONTROL] == pytest.approx(3e4 * ab["tip_twist"], rel=1e-9)
+    assert "open" not in pl.turbulence or CONTROL not in pl.turbulence["open"].a_bar
+    rec = run_gust_loads(st).record(0, "closed")["loads"][CONTROL]
+    assert rec["turbulence"] == pytest.approx(pl.u_sigma * ab[CONTROL], rel=1e-12)
+
+
+def test_u_sigma_is_interpolated_between_vc_and_vd():
+    """CS-25.341(b)(3)(ii)-(iii): U_sigma halves at V_D and is linear between V_C and V_D
+    (90 ft/s x F_g at sea level at V_C). The discrete gusts between are those of V_C."""
+    pts = (
+        FlightPoint(0.0, 100.0, "V_C", "nominal"),
+        FlightPoint(0.0, 112.5, "", "nominal"),
+        FlightPoint(0.0, 125.0, "V_D", "nominal"),
+    )
+    st = _study(
+        controller=None, controls=(), sensors=(), points=pts, v_c=100.0, v_d=125.0, turbulence=True
+    )
+    u = [evaluate_point(st, p).u_sigma for p in pts]
+    ft = 0.3048
+    assert u == pytest.approx([90 * ft, 0.75 * 90 * ft, 0.5 * 90 * ft], rel=1e-12)
+    mid = evaluate_point(st, pts[1])
+    assert any("U_sigma x 0.75" in n for n in mid.notes)
+    vc = evaluate_point(st, pts[0])
+    tas = pts[1].tas / pts[0].tas  # same gust velocities (V_C), the wing faster
+    assert mid.discrete["open"].amplitudes == pytest.approx(vc.discrete["open"].amplitudes)
+    assert tas > 1
+    with pytest.raises(InputError, match="v_d = 90 m/s EAS: must exceed v_c = 100"):
+        _study(controller=None, controls=(), sensors=(), v_c=100.0, v_d=90.0)
+    with pytest.raises(InputError, match="V_C = 110 m/s EAS"):
+        _study(controller=None, controls=(), sensors=(), v_c=110.0, v_d=130.0)
+    with pytest.raises(InputError, match="beyond v_d"):
+        _study(
+            controller=None,
+            controls=(),
+            sensors=(),
+            v_c=90.0,
+            v_d=100.0,
+            points=(FlightPoint(0.0, 120.0, "", "nominal"),),
+        )

@@ -92,7 +92,7 @@ def test_sampled_loop_against_a_loop_closed_by_hand(plant, gain):
     twist = ref[:, list(plant.output_labels).index("tip_twist")]
     cmd = y[:, list(march.outputs).index(CONTROL)]
     assert np.abs(cmd + gain * twist).max() < 2e-4 * np.abs(gain * twist).max()
-    assert lim == {CONTROL: (0.0, 0.0)}
+    assert lim == {CONTROL: 0.0}  # seconds at a limit
 
 
 def test_a_loop_that_commands_nothing_is_the_open_loop(plant):
@@ -117,6 +117,17 @@ def test_saturation_is_reported_and_the_command_never_exceeds_its_limit(plant):
     res = tuned_gust_loads(plant, 0.0, controller=ctrl, limits=lim, n_gradients=5)
     assert res.saturated and res.limited[CONTROL].max() > 0
     assert res.extremes[CONTROL].maximum == pytest.approx(cap, rel=1e-12)
+    # time at the limit [s] (issue 38: not a share of a march whose length is arbitrary):
+    # counted here from the applied command of one gust, samples at the cap x the period
+    march = LoopGustMarch(plant, ctrl, lim)
+    h = float(res.gradients[-1])
+    t, y, at_limit = march.response(h, float(res.amplitudes[-1]), 2 * h / plant.speed + 1.0)
+    u = y[:, list(march.outputs).index(CONTROL)]
+    counted = np.count_nonzero(np.abs(u) >= cap * (1 - 1e-12)) * (t[1] - t[0])
+    assert counted > 0 and at_limit[CONTROL] == pytest.approx(counted, rel=1e-12)
+    assert res.limited[CONTROL][-1, 0] == pytest.approx(counted, rel=1e-12)
+    longer = march.response(h, float(res.amplitudes[-1]), 2 * h / plant.speed + 3.0)[2]
+    assert longer[CONTROL] == pytest.approx(counted, rel=1e-12)  # march length does not count
     assert not free.saturated
     # a symmetric limit keeps the loop odd: the down gust mirrors the up gust
     assert np.allclose(res.peaks_negative, -res.peaks[:, :, ::-1], rtol=1e-9, atol=0)

@@ -14,7 +14,7 @@ from aeroservo.linear import (
     modal_controllability,
     statespace,
 )
-from aeroservo.linear.signals import sensor_row
+from aeroservo.linear.output_rows import sensor_row
 
 RHO = 1.225
 
@@ -144,7 +144,7 @@ def test_frequency_response_matches_direct_solve(aileron10, kind):
     here from the model; its rounding, eps times that factor, is added to the tolerance, so the
     test holds on any BLAS (the tolerance stays under 1.5e-9 from 70 rad/s up)."""
 
-    from aeroservo.linear.signals import hinge_moment_vector
+    from aeroservo.linear.output_rows import hinge_moment_vector
 
     V = 110.0
     suffix = {"displacement": "disp", "acceleration": "accel"}[kind]

@@ -11,7 +11,7 @@ from .options import add_flight_options, add_model_options, positive_float, quan
 __all__ = ["add_parsers", "HANDLERS"]
 
 FLUTTER_KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
-GUST_KINDS = ("envelope", "correlated", "critical-gusts")
+GUST_KINDS = ("envelope", "correlated", "critical-gusts", "spanwise")
 KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope", *GUST_KINDS[1:], *LCO_KINDS)
 
 
@@ -254,10 +254,12 @@ def _gust_figures(res, src, args: argparse.Namespace, kind: str) -> int:
     which = FIGURES if args.kind is None and args.out is None else (kind.replace("-", "_"),)
     figs = gust_figures(res, which)
     if not figs:
-        raise InputError(
-            f"--kind = {kind!r}: {args.result} has not both root_bending_moment and root_torque "
-            "as loads"
+        need = (
+            "loads at two or more stations (root loads, load_stations)"
+            if kind == "spanwise"
+            else "both root_bending_moment and root_torque as loads"
         )
+        raise InputError(f"--kind = {kind!r}: {args.result} has not {need}")
     for name, fig in figs.items():
         out = Path(args.out) if args.out else src.with_name(f"{src.stem}_{name}.png")
         save_figure(fig, out, dpi=130)

@@ -30,8 +30,10 @@ __all__ = [
     "is_gust_loads_file",
 ]
 
-FORMAT = "aeroservo-gust-loads-1"
-_RECORD_KEYS = ("point", "loop", "loads", "histories", "history_loads", "limited")
+FORMAT = "aeroservo-gust-loads-2"
+"""Format 2 (issue 38): ``time_at_limit`` [s] per control replaces format 1's ``limited``
+(a share of the samples, which depended on the length of the march)."""
+_RECORD_KEYS = ("point", "loop", "loads", "histories", "history_loads", "time_at_limit")
 
 
 def _json_writer(result: GustLoadsResult, summary: dict, npz: Path):
@@ -60,15 +62,50 @@ def _npz_writer(arrays: dict):
     return write
 
 
-def _csv_writer(frame):
+def _csv_writer(frame, float_format: str | None = None):
     """A writer of the CSV of ``frame()`` (a DataFrame made when it writes)."""
-    return lambda p: p.write_text(frame().to_csv(index=False), encoding="utf-8")
+    return lambda p: p.write_text(
+        frame().to_csv(index=False, float_format=float_format), encoding="utf-8"
+    )
+
+
+def history_frame(result: GustLoadsResult):
+    """The time histories of the critical gusts as one long table (pandas DataFrame): a row per
+    sample of each critical gust (``point``, ``loop``, ``gradient_m``, ``gust_sign``: those of
+    the limit-load table's ``max_gradient_m`` / ``max_sign`` and ``min_...``), with the time
+    [s], the gust [m/s TAS] and every load (and control applied) in SI units."""
+    import pandas as pd
+
+    frames = []
+    for r in result.records:
+        seen = set()
+        names = [n for n in r["history_loads"] if n in r["loads"]]
+        cols = [r["history_loads"].index(n) for n in names]
+        for load, sides in r["histories"].items():
+            for side, key in sides.items():
+                if key in seen:
+                    continue
+                seen.add(key)
+                v = r["loads"][load]
+                t = np.asarray(result.arrays[key + "_t"])
+                y = np.asarray(result.arrays[key + "_y"])[:, cols]
+                head = {
+                    "point": r["point"],
+                    "loop": r["loop"],
+                    "gradient_m": v[f"{side}_gradient"],
+                    "gust_sign": v[f"{side}_sign"],
+                    "t_s": t,
+                    "gust_m_s": np.asarray(result.arrays[key + "_gust"]),
+                }
+                frames.append(pd.DataFrame(head | {n: y[:, i] for i, n in enumerate(names)}))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
 def gust_loads_items(result: GustLoadsResult, json_path: str | Path, summary: dict) -> dict:
     """The files of a result, ``{kind: (path, writer)}`` for
     :func:`aeroservo.atomic.atomic_write_set`: ``summary`` (the JSON: ``summary`` and every
-    record), ``arrays`` (the NPZ next to it), ``table`` (the CSV of limit loads) and
+    record), ``arrays`` (the NPZ next to it), ``table`` (the CSV of limit loads),
+    ``histories`` (the CSV of the critical gusts' time histories, :func:`history_frame`) and
     ``alleviation`` (its CSV, when the result has both loops). The texts are made when the
     writers run, so ``summary`` may still be completed (e.g. with the files written)."""
     json_path = Path(json_path)
@@ -78,6 +115,10 @@ def gust_loads_items(result: GustLoadsResult, json_path: str | Path, summary: di
         "summary": (json_path, _json_writer(result, summary, npz)),
         "arrays": (npz, _npz_writer(result.arrays)),
         "table": (stem.with_suffix(".csv"), _csv_writer(lambda: result.table)),
+        "histories": (
+            stem.parent / f"{stem.name}_histories.csv",
+            _csv_writer(lambda: history_frame(result), "%.7g"),  # the march is good to 1e-5
+        ),
     }
     if result.loops == ["open", "closed"]:
         path = stem.parent / f"{stem.name}_alleviation.csv"
@@ -94,7 +135,8 @@ def write_gust_loads(
     ----------
     result : GustLoadsResult
     path : str or Path
-        The ``.json`` file; the ``.npz``, ``.csv`` and ``_alleviation.csv`` go next to it.
+        The ``.json`` file; the ``.npz``, ``.csv``, ``_histories.csv`` and
+        ``_alleviation.csv`` go next to it.
     summary : dict, optional
         The run's summary (default :func:`aeroservo.studies.gust_scenario.gust_summary`).
 
@@ -138,7 +180,12 @@ def load_gust_loads(path: str | Path) -> GustLoadsResult:
         _fail(path, f"not JSON: {' '.join(str(exc).split())}")
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else None
-        _fail(path, f"format {found!r}, expected {FORMAT!r}")
+        older = (
+            " (written by an older aeroservo: run the study again)"
+            if found == ("aeroservo-gust-loads-1")
+            else ""
+        )
+        _fail(path, f"format {found!r}, expected {FORMAT!r}{older}")
     records = doc.get("records")
     if not isinstance(records, list) or not all(
         isinstance(r, dict) and all(k in r for k in _RECORD_KEYS) for r in records

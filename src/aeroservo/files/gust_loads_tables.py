@@ -74,10 +74,23 @@ def gust_loads_table(gl: Table, base: Path, wing) -> dict:
     """The ``[gust_loads]`` table: loads, gust search, turbulence, F_g, mass cases and points."""
     gl.check_keys(
         ("points",),
-        ("loads", "n_gradients", "turbulence", "workers", "f_g", "weights", "mass_cases"),
+        (
+            "loads",
+            "stations",
+            "n_gradients",
+            "turbulence",
+            "workers",
+            "f_g",
+            "weights",
+            "mass_cases",
+            "v_c",
+            "v_d",
+        ),
     )
+    stations = gl.numbers("stations", [], unit="m", lo=0.0, hi=wing.span, increasing=True)
     out: dict = {
         "loads": tuple(gl.strings("loads", DEFAULT_LOADS)),
+        "stations": tuple(stations),
         "n_gradients": gl.integer("n_gradients", 20, lo=3, hi=500),
         "turbulence": gl.boolean("turbulence", True),
         "workers": gl.integer("workers", 0, lo=0, hi=256),
@@ -86,8 +99,12 @@ def gust_loads_table(gl: Table, base: Path, wing) -> dict:
         gl.fail("weights", gl.data["weights"], "give f_g or weights, not both")
     out["weights"] = _weights(gl.table("weights")) if gl.has("weights") else {}
     out["f_g"] = None if out["weights"] else gl.number("f_g", 1.0, lo=0.0, lo_open=True, hi=1.0)
+    for key in ("v_c", "v_d"):  # design cruising and dive speeds [m/s EAS]
+        out[key] = gl.number(key, None, unit="m/s EAS", lo=0.0, lo_open=True, hi=1000.0)
+    if out["v_c"] is not None and out["v_d"] is not None and out["v_d"] <= out["v_c"]:
+        gl.fail("v_d", out["v_d"], f"must exceed v_c = {out['v_c']:g} m/s EAS")
     out["mass_cases"] = _mass_cases(gl, base, wing)
-    out["points"] = _points(gl, out["mass_cases"])
+    out["points"] = _points(gl, out["mass_cases"], out["v_c"], out["v_d"])
     return out
 
 
@@ -134,8 +151,9 @@ def _mass_cases(gl: Table, base: Path, wing) -> dict:
     return cases
 
 
-def _points(gl: Table, cases: dict) -> tuple:
-    """``[[gust_loads.points]]``: altitude [m], speed [m/s EAS], speed_name, mass_case."""
+def _points(gl: Table, cases: dict, v_c=None, v_d=None) -> tuple:
+    """``[[gust_loads.points]]``: altitude [m], speed [m/s EAS], speed_name, mass_case (a
+    point named V_C or V_D flies at ``v_c`` or ``v_d`` when given; none beyond ``v_d``)."""
     items = gl.data["points"]
     if not isinstance(items, list) or not items:
         gl.fail("points", items, "expected [[gust_loads.points]] tables (altitude, speed)")
@@ -149,6 +167,16 @@ def _points(gl: Table, cases: dict) -> tuple:
         altitude = pt.number("altitude", unit="m (the rule's table)", lo=0.0, hi=top, required=True)
         speed = pt.number("speed", quantity="flight_speed", required=True)
         speed_name = pt.string("speed_name", "V_C", choices=SPEED_NAMES)
+        at = {"V_C": v_c, "V_D": v_d}.get(speed_name)
+        if at is not None and abs(speed - at) > 1e-9 * at:
+            pt.fail(
+                "speed",
+                speed,
+                f"the point is named {speed_name} = {at:g} m/s EAS "
+                '(speed_name = "" for a speed in between)',
+            )
+        if speed_name == "" and v_d is not None and speed > v_d * (1 + 1e-9):
+            pt.fail("speed", speed, f"beyond v_d = {v_d:g} m/s EAS (the envelope ends at V_D)")
         case = pt.string("mass_case", NOMINAL)
         if case not in cases:
             pt.fail("mass_case", case, f"not a mass case; they are {list(cases)}")
@@ -170,7 +198,16 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
     for case, wing in g["mass_cases"].items():
         where = "" if case == NOMINAL else f" (mass case {case!r})"
         aero = "strip" if s.aero is None else s.aero
-        model = AeroelasticModel(wing, s.elements, s.wagner, damping=s.damping, aero=aero)
+        for x in g["stations"]:
+            if x > wing.span:
+                gl.fail(
+                    "stations",
+                    list(g["stations"]),
+                    f"{x:g} m is beyond the span {wing.span:g} m of mass case {case!r}",
+                )
+        model = AeroelasticModel(
+            wing, s.elements, s.wagner, damping=s.damping, aero=aero, load_stations=g["stations"]
+        )
         for i, name in enumerate(g["loads"]):
             try:
                 resolve_outputs(model, [name], model.n_dofs)

@@ -9,10 +9,11 @@ range) for a controlled linear loop, and ``<result>.json``; a trade study writes
 :data:`aeroservo.studies.trade.plots.HEATMAP_METRICS`) and ``pareto.png`` into its folder
 ``<result>/`` (next to its case store, ``<result>.csv`` and ``<result>.nc``); gust loads write
 ``<result>.json`` (summary and every record), ``<result>.npz`` (critical-gust histories),
-``<result>.csv`` (limit loads), ``<result>_alleviation.csv`` (both loops) and the figures
-``<result>_envelope.png``, ``<result>_correlated.png`` and ``<result>_critical_gusts.png``
-(:mod:`aeroservo.files.gust_loads_file`); limit cycles write ``<result>.json``, ``<result>.csv``,
-``<result>_branches.csv``, ``<result>_histories.npz``, ``<result>_summary.txt``,
+``<result>.csv`` (limit loads), ``<result>_histories.csv`` (the critical gusts' time
+histories), ``<result>_alleviation.csv`` (both loops) and the figures ``<result>_envelope.png``,
+``<result>_correlated.png``, ``<result>_critical_gusts.png`` and ``<result>_spanwise.png`` (with
+load stations) (:mod:`aeroservo.files.gust_loads_file`); limit cycles write ``<result>.json``,
+``<result>.csv``, ``<result>_branches.csv``, ``<result>_histories.npz``, ``<result>_summary.txt``,
 ``<result>_bifurcation.png`` and ``<result>_histories.png`` (:mod:`aeroservo.files.lco_file`).
 Every file of a
 run is renamed into place only when all of them have been written

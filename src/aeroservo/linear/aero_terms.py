@@ -44,14 +44,15 @@ class AeroTerms:
         Aerodynamic generalized forces on the unknowns (apparent mass apart).
     Fu : ndarray (2, n_q)
         Their direct gust term.
-    Fr, Fru : ndarray (3, 3, n_a), (2, 3)
-        The same on the clamped root's ``w, theta, phi``.
-    mnc, root_mnc : ndarray (n_q, n_q), (3, n_q)
+    Fr, Fru : ndarray (3, n_r, n_a), (2, n_r)
+        The same on the clamped root's ``w, theta, phi``, then on those of each cut node asked
+        for (``cut_nodes``; ``n_r = 3 (1 + len(cut_nodes))``).
+    mnc, root_mnc : ndarray (n_q, n_q), (n_r, n_q)
         Apparent mass per unit density: the aerodynamic force holds ``-rho mnc qddot``.
     Ks, Cs : ndarray (n_q, n_q), ndarray or None
         Structural stiffness and damping in the unknowns.
-    root_Ks, root_Ms : ndarray (3, n_q)
-        Root rows of the structural stiffness and mass.
+    root_Ks, root_Ms : ndarray (n_r, n_q)
+        Root (and cut) rows of the structural stiffness and mass.
     gust_labels : tuple of str
     """
 
@@ -85,6 +86,7 @@ def strip_terms(
     has_gust: bool,
     gust: str,
     kussner: IndicialSet,
+    cut_nodes: tuple[int, ...] = (),
 ) -> AeroTerms:
     """Strip theory's terms: Wagner lag states per node, Kussner gust states per distinct
     semichord (or the upwash gust through the lag states).
@@ -102,6 +104,8 @@ def strip_terms(
         Whether the gust is an input.
     gust : {"kussner", "upwash"}
     kussner : IndicialSet
+    cut_nodes : tuple of int
+        Nodes whose internal loads are wanted, after the root's (rows of ``Fr``).
     """
     am = model.matrices
     basis = None
@@ -128,7 +132,8 @@ def strip_terms(
     # aerodynamic generalized forces (without apparent mass) on the free and root unknowns
     scale = cf * (1.0 - sum(wag.A))
     ab = cf * beta2 * np.asarray(wag.A) * np.asarray(wag.b)
-    rt = am.root
+    rt = am.reaction_rows(tuple(cut_nodes))
+    n_r = rt.Ks.shape[0]
     Ks = _dense(am.Ks)
     Cs = None if am.Cs is None else _dense(am.Cs)
     Fa = np.zeros((3, n_q, n))
@@ -136,12 +141,12 @@ def strip_terms(
     Fa[0, :, iq] += Ks
     if Cs is not None:  # structural damping is not an aerodynamic force
         Fa[0, :, iv] += Cs
-    Fr = np.zeros((3, 3, n))
+    Fr = np.zeros((3, n_r, n))
     Fr[2, :, iq] = -rho * _dense(rt.Knc - scale * rt.Pq)
     Fr[1, :, iv] = -rho * _dense(rt.Cnc - scale * rt.Pd)
     Fr[2, :, iz] = rho * np.kron(_dense(rt.W1), ab[None, :])
     Fu = np.zeros((2, n_q))
-    Fru = np.zeros((2, 3))
+    Fru = np.zeros((2, n_r))
     Bg = np.zeros((2, n))
 
     g_states = []

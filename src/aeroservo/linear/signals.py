@@ -23,6 +23,11 @@ Outputs (by name, or :class:`Sensor` for any point):
   the surface, positive trailing-edge down;
 * ``root_shear`` [N], ``root_bending_moment`` [N m], ``root_torque`` [N m] - internal loads
   carried by the root section (positive for upward loads, tip-up bending, nose-up torque);
+* ``shear_at_<x>mm`` [N], ``bending_moment_at_<x>mm`` [N m], ``torque_at_<x>mm`` [N m] - the
+  same at the spanwise station ``<x>`` in whole millimetres (e.g. ``bending_moment_at_2500mm``
+  at 2.5 m; python-control allows no '.' in a name), which must be a mesh node within 0.5 mm
+  (``AeroelasticModel(..., load_stations=[2.5])`` puts one there): the loads the wing carries
+  there from everything outboard (``docs/gust-loads.md``);
 * ``modal_<k>`` [kg^0.5 m] - k-th in-vacuo modal coordinate (mass-normalized modes).
 """
 
@@ -36,8 +41,6 @@ import numpy as np
 
 from ..errors import InputError, check_number
 from ..errors import show_value as describe
-from ..structure.beam_element import point_shapes
-from ..system.swept_assembly import kink_transforms
 
 __all__ = [
     "Sensor",
@@ -116,6 +119,7 @@ class OutputDef:
     surface: int | None = None
     sensor: Sensor | None = None
     index: int | None = None
+    node: int | None = None  # the mesh node of a load station
 
 
 def input_names(wing) -> dict[str, InputDef]:
@@ -242,6 +246,14 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
             idx = ("root_shear", "root_bending_moment", "root_torque").index(spec)
             out.append(OutputDef(spec, "root", unit, index=idx))
             continue
+        m = _CUT.match(spec)
+        if m:
+            quantity, station = m.groups()
+            node = _station_node(model, spec, station)
+            unit = "N" if quantity == "shear" else "N m"
+            idx = ("shear", "bending_moment", "torque").index(quantity)
+            out.append(OutputDef(spec, "cut", unit, index=idx, node=node))
+            continue
         m = _MODAL.match(spec)
         if m:
             digits = m.group(1).lstrip("0") or "0"
@@ -278,6 +290,7 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
                     "root_shear",
                     "root_bending_moment",
                     "root_torque",
+                    "{shear,bending_moment,torque}_at_<station>mm",
                     "modal_<k>",
                 ]
                 + [f"{s}_{{deflection,rate,aero_hinge_moment,actuator_moment}}" for s in surfaces]
@@ -290,6 +303,35 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
     return out
 
 
+_CUT = re.compile(r"^(shear|bending_moment|torque)_at_(.*)mm$")
+
+
+def station_output(quantity: str, station: float) -> str:
+    """Name of the load output at a station [m], e.g. ``bending_moment_at_2500mm``."""
+    return f"{quantity}_at_{round(station * 1000.0)}mm"
+
+
+def _station_node(model, spec: str, station: str) -> int:
+    """The mesh node at the station of a load output ``<quantity>_at_<x>mm``."""
+    span = model.wing.span
+    x = int(station) / 1000.0 if station.isdigit() and len(station) <= 9 else -1.0
+    if not 0.0 <= x <= span * (1 + 1e-12) + 5e-4:
+        raise InputError(
+            f"output {describe(spec)}: the station after '_at_' must be whole millimetres in "
+            f"[0, {span * 1000:.0f}], e.g. {station_output('bending_moment', 0.5 * span)!r}"
+        )
+    nodes = model.mesh.nodes
+    j = int(np.argmin(np.abs(nodes - x)))
+    if abs(nodes[j] - x) > max(5e-4, 1e-9 * span):
+        near = ", ".join(f"{v:.6g}" for v in nodes[max(j - 1, 0) : j + 2])
+        raise InputError(
+            f"output {describe(spec)}: no mesh node at {x:g} m (nearest nodes {near} m); "
+            f"put one there with AeroelasticModel(..., load_stations=[{x:g}]) (a study's "
+            "load_stations do)"
+        )
+    return j
+
+
 def output_units(defs) -> dict[str, str]:
     return {d.name: d.unit for d in defs}
 
@@ -300,99 +342,3 @@ def _no_duplicates(names: list[str], what: str) -> None:
         if n in seen:
             raise InputError(f"{what}: {n!r} appears twice")
         seen.add(n)
-
-
-# -- rows and vectors over the (full) structural unknowns --------------------------------------
-
-
-def _scatter_row(model, e: int, local: np.ndarray) -> np.ndarray:
-    row = np.zeros(model.n_dofs)
-    dofs = model.mesh.element_dofs[e]
-    keep = dofs >= 0
-    np.add.at(row, dofs[keep], local[keep])
-    return row
-
-
-def _element_on(model, x: float, surface: int | None = None) -> tuple[int, float]:
-    """Element containing x (restricted to a surface's elements if given) and local xi."""
-    mesh = model.mesh
-    if surface is None:
-        return mesh.locate(x)
-    own = np.flatnonzero(mesh.surface == surface)
-    i = np.searchsorted(mesh.nodes[own + 1], x - 1e-12 * model.wing.span)
-    e = own[min(i, own.size - 1)]
-    xi = (x - mesh.nodes[e]) / (mesh.nodes[e + 1] - mesh.nodes[e])
-    return int(e), float(np.clip(xi, 0.0, 1.0))
-
-
-def field_row(model, field: int, x: float, surface: int | None = None) -> np.ndarray:
-    """Row r with ``r @ q`` = field value at x (0 = w, 1 = phi, 2 = delta of ``surface``)."""
-    e, xi = _element_on(model, x, surface if field == 2 else None)
-    n, _ = point_shapes(model.mesh.lengths[e], xi)
-    kinks = kink_transforms(model.wing, model.mesh)  # None unless the elastic axis is cranked
-    return _scatter_row(model, e, n[field] if kinks is None else n[field] @ kinks[e])
-
-
-def surface_at(model, x: float) -> int | None:
-    """Index of the control surface covering station x on the mesh, or None."""
-    tol = 1e-12 * model.wing.span
-    for k, (start, end) in enumerate(model.mesh.surface_extent):
-        if start - tol <= x <= end + tol:
-            return k
-    return None
-
-
-def sensor_row(model, s: Sensor) -> np.ndarray:
-    """Displacement (or twist) row of a sensor; rates and accelerations use the same row."""
-    if s.quantity in ("twist", "twist_rate"):
-        return field_row(model, 1, s.x)
-    seg = model.wing.segment_at(s.x)
-    y = seg.semichord * (s.chord - seg.a)  # m aft of the elastic axis
-    row = field_row(model, 0, s.x) - y * field_row(model, 1, s.x)
-    k = surface_at(model, s.x)
-    if k is not None and s.chord > model.wing.control_surfaces[k].hinge:
-        y_h = seg.semichord * (model.wing.control_surfaces[k].hinge - seg.a)
-        row -= (y - y_h) * field_row(model, 2, s.x, k)
-    return row
-
-
-def surface_unit(model, k: int) -> np.ndarray:
-    """Vector with a unit rotation of surface k: ``e @ f`` is the moment about the hinge."""
-    e = np.zeros(model.n_dofs)
-    d = model.mesh.dof_delta[k]
-    e[d[d >= 0]] = 1.0
-    return e
-
-
-def surface_mean_row(model, k: int) -> np.ndarray:
-    """Row giving the span-averaged rotation of surface k (trapezoidal rule: exact, linear)."""
-    mesh = model.mesh
-    d = mesh.dof_delta[k]
-    on = d >= 0
-    x = mesh.nodes[on]
-    w = np.zeros(x.size)
-    h = np.diff(x)
-    w[:-1] += h / 2
-    w[1:] += h / 2
-    row = np.zeros(model.n_dofs)
-    row[d[on]] = w / (x[-1] - x[0])
-    return row
-
-
-def actuator_rows(model, k: int) -> list[tuple[float, np.ndarray]]:
-    """(stiffness, row of delta at the actuator) for each actuator of surface k."""
-    cs = model.wing.control_surfaces[k]
-    return [(a.stiffness, field_row(model, 2, a.station, k)) for a in cs.actuators]
-
-
-def hinge_moment_vector(model, k: int) -> np.ndarray:
-    """Generalized force of a unit hinge moment of surface k [per N m].
-
-    At the actuators in proportion to their stiffness; without actuators, spread evenly along
-    the surface (a uniform distributed hinge moment of 1/L_s N m per m).
-    """
-    acts = actuator_rows(model, k)
-    if acts:
-        k_tot = sum(a for a, _ in acts)
-        return sum((a / k_tot) * r for a, r in acts)
-    return surface_mean_row(model, k)

@@ -25,20 +25,16 @@ from ..errors import RANGES, InputError, check_int, check_number
 from ..system.first_order import check_mach
 from .aero_terms import strip_terms
 from .dlm_terms import dlm_terms
-from .polynomial import _dense, _Poly
-from .servo import Servo, servos_of
-from .signals import (
-    Sensor,
+from .output_rows import (
     actuator_rows,
-    describe,
     hinge_moment_vector,
-    output_units,
-    resolve_inputs,
-    resolve_outputs,
     sensor_row,
     surface_mean_row,
     surface_unit,
 )
+from .polynomial import _dense, _Poly
+from .servo import Servo, servos_of
+from .signals import Sensor, describe, output_units, resolve_inputs, resolve_outputs
 from .tags import system_name, tag
 
 __all__ = ["Servo", "StateSpaceBuilder", "MAX_SPEED", "DENSITIES"]
@@ -125,10 +121,18 @@ class StateSpaceBuilder:
         modes = model.natural_modes(n_need) if n_need else None
         self.mach = mach = _check_mach(model, mach)
         has_gust = any(d.kind == "gust" for d in self.inputs)
+        cuts = tuple(dict.fromkeys(o.node for o in self.outputs if o.kind == "cut"))
         if model.dlm is not None:
+            if cuts:
+                raise InputError(
+                    "outputs <quantity>_at_<x>: loads along the span need the strip model; "
+                    "the doublet-lattice model gives the root loads only"
+                )
             terms = dlm_terms(model, rho, mach, n_modes, has_gust, gust)
         else:
-            terms = strip_terms(model, rho, mach, modes, n_modes, has_gust, gust, self.kussner)
+            terms = strip_terms(
+                model, rho, mach, modes, n_modes, has_gust, gust, self.kussner, cut_nodes=cuts
+            )
         self.n_modes = n_modes
         self.basis = basis = terms.basis
 
@@ -152,10 +156,11 @@ class StateSpaceBuilder:
         A[:, :n_a, :n_a] = terms.A
         Fa = np.zeros((3, n_q, n))
         Fa[:, :, :n_a] = terms.Fa
-        Fr = np.zeros((3, 3, n))
+        n_r = terms.Fr.shape[1]  # root rows, then those of each cut node
+        Fr = np.zeros((3, n_r, n))
         Fr[:, :, :n_a] = terms.Fr
         Fu = np.zeros((2, n_q, m))
-        Fru = np.zeros((2, 3, m))
+        Fru = np.zeros((2, n_r, m))
         col = {d.name: j for j, d in enumerate(self.inputs)}
         if "gust" in col:
             j = col["gust"]
@@ -250,8 +255,8 @@ class StateSpaceBuilder:
                         Du[0, i, col[d.name]] = k_tot
                     elif d.kind == "command":
                         Cx[0, i, self._servo_index[k]] = k_tot
-            elif o.kind == "root":
-                r = o.index
+            elif o.kind in ("root", "cut"):
+                r = o.index if o.kind == "root" else 3 + 3 * cuts.index(o.node) + o.index
                 Cx[:, i, :] = Fr[:, r, :]
                 Cx[0, i, iq] -= terms.root_Ks[r]
                 Du[:, i, :] = Fru[:, r, :]

@@ -165,6 +165,21 @@ class SimulationResult:
             out[c] = float(np.mean(limited)) if dt > 0 else 0.0
         return out
 
+    def time_at_limit(self) -> dict:
+        """Time [s] each control spent at its magnitude or rate limit: the samples at either
+        (as :attr:`saturated_fraction` and :attr:`rate_limited_fraction` count them) times the
+        sample period (a measure that does not depend on the length of the march)."""
+        mag, rate = self.limits.arrays(list(self.applied))
+        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
+        out = {}
+        for i, (c, u) in enumerate(self.applied.items()):
+            u = np.asarray(u, dtype=float)
+            at_mag = np.abs(u) >= mag[i] * (1 - 1e-12)
+            step = np.abs(np.diff(np.r_[0.0, u]))
+            at_rate = np.isfinite(rate[i]) & (step >= rate[i] * dt * (1 - 1e-9))
+            out[c] = float(np.count_nonzero(at_mag | at_rate)) * dt
+        return out
+
     def plot(
         self,
         tip: str | None = None,

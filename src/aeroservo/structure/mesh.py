@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MAX_ELEMENTS, InputError, check_int
+from ..errors import MAX_ELEMENTS, InputError, check_int, check_number
 from .wing import Wing
 
 __all__ = ["Mesh", "build_mesh", "LOCAL_DOFS", "EDGE_TOLERANCE"]
@@ -101,10 +101,12 @@ class Mesh:
         return e, float(np.clip(xi, 0.0, 1.0))
 
 
-def _edges(wing: Wing) -> tuple[list[tuple[float, int, str]], float]:
-    """Every breakpoint with its priority (0 root/tip, 1 segment edge, 2 surface edge)."""
+def _edges(wing: Wing, stations=()) -> tuple[list[tuple[float, int, str]], float]:
+    """Every breakpoint with its priority (0 root/tip, 1 segment edge, 2 surface edge, 3 load
+    station)."""
     span = wing.span
     pts = [(0.0, 0, "the root"), (span, 0, "the tip")]
+    pts += [(float(x), 3, f"load station {x:g} m") for x in stations]
     for i, seg in enumerate(wing.segments[:-1]):
         pts.append((seg.end, 1, f"segments[{i}].end"))
     for cs in wing.control_surfaces:
@@ -115,13 +117,13 @@ def _edges(wing: Wing) -> tuple[list[tuple[float, int, str]], float]:
     return sorted(pts), EDGE_TOLERANCE * span
 
 
-def _merged_edges(wing: Wing) -> tuple[dict[float, float], np.ndarray, list[str]]:
+def _merged_edges(wing: Wing, stations=()) -> tuple[dict[float, float], np.ndarray, list[str]]:
     """Clusters of edges closer than the tolerance, each replaced by one representative.
 
     Returns the map from every original edge to its representative, the sorted breakpoints
     and one warning per merge.
     """
-    pts, tol = _edges(wing)
+    pts, tol = _edges(wing, stations)
     clusters: list[list[tuple[float, int, str]]] = []
     for p in pts:
         if clusters and p[0] - clusters[-1][-1][0] < tol:
@@ -133,7 +135,7 @@ def _merged_edges(wing: Wing) -> tuple[dict[float, float], np.ndarray, list[str]
     for cl in clusters:
         best = min(c[1] for c in cl)
         tops = [c for c in cl if c[1] == best]
-        rep = tops[0][0] if best < 2 else float(np.mean([c[0] for c in cl]))
+        rep = tops[0][0] if best < 2 else float(np.mean([c[0] for c in tops]))
         if any(c[1] == 0 and c[0] == 0.0 for c in cl):
             rep = 0.0
         for c in cl:
@@ -159,7 +161,7 @@ def _allocate(lengths: np.ndarray, n: int) -> np.ndarray:
     return counts
 
 
-def build_mesh(wing: Wing, n_elements: int) -> Mesh:
+def build_mesh(wing: Wing, n_elements: int, stations: tuple[float, ...] = ()) -> Mesh:
     """Mesh a wing with ``n_elements`` beam elements.
 
     Parameters
@@ -167,15 +169,20 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
     wing : Wing
         The wing.
     n_elements : int
-        Total number of elements; at least one per interval between segment boundaries and
-        control-surface edges.
+        Total number of elements; at least one per interval between segment boundaries,
+        control-surface edges and load stations.
+    stations : tuple of float
+        Load stations [m]: nodes are put there (a station closer than the edge tolerance to an
+        edge moves to it, with a warning), so that the loads there are outputs.
 
     Returns
     -------
     Mesh
     """
     n_elements = check_int("n_elements", n_elements, lo=1, hi=MAX_ELEMENTS)
-    snap, bp, warnings = _merged_edges(wing)
+    for x in stations:
+        check_number("load station", x, unit="m", lo=0.0, hi=wing.span)
+    snap, bp, warnings = _merged_edges(wing, stations)
     extent = np.array([[snap[cs.start], snap[cs.end]] for cs in wing.control_surfaces])
     extent = extent.reshape(len(wing.control_surfaces), 2)
     for k, cs in enumerate(wing.control_surfaces):
@@ -187,7 +194,7 @@ def build_mesh(wing: Wing, n_elements: int) -> Mesh:
     if n_elements < bp.size - 1:
         raise InputError(
             f"n_elements = {n_elements}: at least {bp.size - 1} are needed to put nodes at "
-            "every segment boundary and control-surface edge"
+            "every segment boundary, control-surface edge and load station"
         )
     counts = _allocate(np.diff(bp), n_elements)
     nodes = np.concatenate(

@@ -77,11 +77,11 @@ def _span(t, y, t_gust: float) -> float:
 def _draw_control(ax, result, rec: dict, control: str, t, u, k: int) -> None:
     """A control applied by the loop, with its magnitude limit when stored and near."""
     unit, f = display_unit(result, control)
-    share = rec["limited"].get(control, 0.0)
+    at_limit = rec["time_at_limit"].get(control, 0.0)
     limit = magnitude_limit(result, control)
     label = f"{control} (closed loop)"
-    if limit is None and share > 0:
-        label += f": at a limit in up to {100 * share:.1f} % of the samples (limit not stored)"
+    if limit is None and at_limit > 0:
+        label += f": at a limit for up to {at_limit:.3g} s in a gust (limit not stored)"
     elif limit is None:
         label += ": never at a limit in the search"
     ax.plot(t, u * f, color=f"C{k + 2}", lw=1.2, label=label)
@@ -116,7 +116,9 @@ def plot_gust_history(result, point: int, load: str, side: str = "max") -> Figur
     if not recs:
         raise InputError(f"load {load!r}: not computed at point {point} (see the notes)")
     closed = recs.get("closed")
-    controls = [c for c in closed["limited"] if c in closed["history_loads"]] if closed else []
+    controls = (
+        [c for c in closed["time_at_limit"] if c in closed["history_loads"]] if closed else []
+    )
     n = 2 + bool(controls)
     fig = new_figure(figsize=(8.0, 2.4 * n + 1.2))
     axs = list(fig.subplots(n, 1, sharex=True))

@@ -98,7 +98,7 @@ class ExactGustMarch:
 
     def response(self, gradient: float, amplitude: float, duration: float):
         """``(t, y, limited)`` for one gust: times [s], outputs (n_t, n_outputs) and the
-        shares of samples at a limit (none open loop)."""
+        time at a limit per control (none open loop)."""
         t = np.arange(int(np.ceil(duration / self.dt)) + 1) * self.dt
         return t, self.run(amplitude * profile(t, self.speed, gradient)), {}
 
@@ -139,8 +139,8 @@ class LoopGustMarch:
         self.outputs = tuple(sys.output_labels) + extra
 
     def response(self, gradient: float, amplitude: float, duration: float):
-        """``(t, y, limited)``: times [s], outputs (n_t, n_outputs) and ``{control:
-        (saturated share, rate-limited share)}`` of the samples."""
+        """``(t, y, limited)``: times [s], outputs (n_t, n_outputs) and ``{control: time [s]
+        at a magnitude or rate limit}``."""
         from ..simulate.march import simulate
 
         half, v = 0.5 * self.dt, self.speed
@@ -159,8 +159,8 @@ class LoopGustMarch:
                 delay=self.delay,
             )
         y = np.column_stack([res.signal(n) for n in self.outputs])
-        sat, rate = res.saturated_fraction, res.rate_limited_fraction
-        return res.t, y, {c: (sat[c], rate[c]) for c in self.controls}
+        at_limit = res.time_at_limit()
+        return res.t, y, {c: at_limit[c] for c in self.controls}
 
 
 def one_minus_cosine_response(

@@ -125,11 +125,11 @@ def point_notes(result, points: list[int], loops: list[str]) -> list[str]:
         lines += [f"point {p} ({point_label(any_record(result, p))}): {n}" for n in notes]
         for lp in loops:
             rec = record_of(result, p, lp)
-            for c, share in (rec["limited"] if rec else {}).items():
-                if share > 0:
+            for c, at_limit in (rec["time_at_limit"] if rec else {}).items():
+                if at_limit > 0:
                     lines.append(
-                        f"point {p}, {lp} loop: {c} at its limit in up to {100 * share:.1f} % "
-                        "of the samples of a gust of the search"
+                        f"point {p}, {lp} loop: {c} at its limit for up to {at_limit:.3g} s "
+                        "in a gust of the search"
                     )
     return lines
 

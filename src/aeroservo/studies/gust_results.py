@@ -12,6 +12,9 @@ Definitions:
   discrete gusts (incremental);
 * turbulence limit load: ``U_sigma A_bar``;
 * limit load: the larger of the two;
+* rigid ratio (root and station shear, bending moment, torque): the discrete limit load over
+  the rigid clamped wing's quasi-static load in the largest design gust
+  (:mod:`~aeroservo.studies.rigid_gust`), a check: near 1 for a stiff wing in a long gust;
 * gust load alleviation of the loop (per load and per point, discrete and turbulence):
   ``100 (1 - closed / open)`` [%] of the limit loads; a loop **raises** a load when the closed
   loop's limit load exceeds the open loop's by more than :data:`RAISE_TOLERANCE`.
@@ -32,7 +35,7 @@ RAISE_TOLERANCE = 1e-3
 times the accuracy of the sampled march against the exact one, ``docs/gust-loads.md``)."""
 
 
-def _extreme_record(e, turb, u_sig: float) -> dict:
+def _extreme_record(e, turb, u_sig: float, rigid: float | None = None) -> dict:
     rec = {"unit": e.unit}
     for side in ("max", "min"):
         value, h, t, sign, corr = e.side(side)
@@ -46,6 +49,8 @@ def _extreme_record(e, turb, u_sig: float) -> dict:
             }
         )
     rec["discrete"] = max(abs(e.maximum), abs(e.minimum))
+    if rigid is not None:
+        rec["rigid"] = rigid
     if turb is not None and e.load in turb.a_bar:
         rec.update(
             a_bar=turb.a_bar[e.load], n0=turb.n0[e.load], turbulence=u_sig * turb.a_bar[e.load]
@@ -54,7 +59,7 @@ def _extreme_record(e, turb, u_sig: float) -> dict:
 
 
 def point_records(index: int, pl, loads) -> tuple[list[dict], dict]:
-    """JSON records and history arrays of one :class:`~aeroservo.studies.gust_loads.PointLoads`
+    """JSON records and history arrays of one :class:`~aeroservo.studies.gust_point.PointLoads`
     (``index``: its place in the study); the records keep ``loads`` and the controls applied,
     the histories every output."""
     p = pl.point
@@ -77,8 +82,10 @@ def point_records(index: int, pl, loads) -> tuple[list[dict], dict]:
         turb = pl.turbulence.get(loop)
         rec = dict(base, loop=loop, controller=d.controller, gust_speed=d.speed)
         keep = [n for n in d.extremes if n in loads or n in d.limited]
-        rec["loads"] = {n: _extreme_record(d.extremes[n], turb, pl.u_sigma) for n in keep}
-        rec["limited"] = {c: float(np.max(a)) for c, a in d.limited.items()}
+        rec["loads"] = {
+            n: _extreme_record(d.extremes[n], turb, pl.u_sigma, pl.rigid.get(n)) for n in keep
+        }
+        rec["time_at_limit"] = {c: float(np.max(a)) for c, a in d.limited.items()}
         rec["gradients"] = [float(h) for h in d.gradients]
         neg = d.peaks_negative if d.peaks_negative is not None else -d.peaks[:, :, ::-1]
         rec["tuning"] = {  # peak of each load over time per scanned gradient, both gust signs
@@ -182,7 +189,8 @@ class GustLoadsResult:
                         "n0_hz": v.get("n0", np.nan),
                         "turbulence": turb,
                         "limit": np.nanmax([v["discrete"], turb]),
-                        "saturated": max(r["limited"].values(), default=0.0),
+                        "rigid_ratio": v["discrete"] / v["rigid"] if v.get("rigid") else np.nan,
+                        "time_at_limit_s": max(r["time_at_limit"].values(), default=0.0),
                     }
                 )
         return pd.DataFrame(rows)
@@ -198,7 +206,9 @@ class GustLoadsResult:
         turb = rows["turbulence"] > rows[["discrete_max", "discrete_min"]].abs().max(axis=1)
         linear = "turbulence (linear loop; the actuator saturates in the gusts)"
         rows = rows.assign(
-            source=np.where(turb, np.where(rows["saturated"] > 0, linear, "turbulence"), "discrete")
+            source=np.where(
+                turb, np.where(rows["time_at_limit_s"] > 0, linear, "turbulence"), "discrete"
+            )
         )
         return rows.set_index("load")
 
@@ -298,9 +308,9 @@ class GustLoadsResult:
                 if (r["point"], note) not in seen:
                     seen.add((r["point"], note))
                     lines.append(f"  note, {_point_label(r)}: {note}")
-            sat = {c: s for c, s in r["limited"].items() if s > 0}
+            sat = {c: s for c, s in r["time_at_limit"].items() if s > 0}
             if sat:
-                parts = ", ".join(f"{c} {100 * s:.1f} % of samples" for c, s in sat.items())
+                parts = ", ".join(f"{c} for up to {s:.3g} s in a gust" for c, s in sat.items())
                 lines.append(
                     f"  {r['loop']} loop at {_point_label(r)}: actuator limit hit ({parts})"
                 )
@@ -339,6 +349,12 @@ class GustLoadsResult:
         from .gust_plots import plot_critical_gusts
 
         return plot_critical_gusts(self, loads, loop)
+
+    def plot_spanwise(self):
+        """Limit loads along the span (:func:`~aeroservo.studies.gust_span_plots.plot_spanwise`)."""
+        from .gust_span_plots import plot_spanwise
+
+        return plot_spanwise(self)
 
     def plot_tuning(self, point: int, load: str):
         """Peak load against the gust gradient H at a flight point

@@ -7,7 +7,8 @@ from __future__ import annotations
 import time
 
 from ..errors import InputError, check_int
-from .gust_loads import GustLoadsStudy, PointLoads, design_point, evaluate_point
+from .gust_loads import GustLoadsStudy
+from .gust_point import PointLoads, design_point, evaluate_point
 from .gust_results import GustLoadsResult, point_records
 
 __all__ = ["run_gust_loads"]

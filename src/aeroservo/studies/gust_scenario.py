@@ -44,6 +44,9 @@ def gust_study(scenario: Scenario):
         mass_cases=dict(g["mass_cases"]),
         points=tuple(g["points"]),
         loads=tuple(g["loads"]),
+        load_stations=tuple(g["stations"]),
+        v_c=g.get("v_c"),
+        v_d=g.get("v_d"),
         controls=tuple(scenario.controls) if loop else (),
         sensors=tuple(scenario.sensors) if loop else (),
         outputs=tuple(scenario.outputs) if loop else (),
@@ -159,9 +162,14 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
             for n in k["notes"]
         ],
         "saturation": [
-            {"point": r["point"], "flight_point": _label(r), "loop": r["loop"], **r["limited"]}
+            {
+                "point": r["point"],
+                "flight_point": _label(r),
+                "loop": r["loop"],
+                "time_at_limit_s": r["time_at_limit"],
+            }
             for r in result.records
-            if any(s > 0 for s in r["limited"].values())
+            if any(s > 0 for s in r["time_at_limit"].values())
         ],
         "settings": dict(result.settings),
         "units": dict(result.units),
@@ -175,24 +183,26 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
     return summary
 
 
-FIGURES = ("envelope", "correlated", "critical_gusts")
+FIGURES = ("envelope", "correlated", "critical_gusts", "spanwise")
 """The figures of a gust-loads run, by file suffix (:func:`gust_figures`)."""
 
 
 def gust_figures(result, which=FIGURES) -> dict:
     """The figures a gust-loads run writes, by file suffix: ``envelope`` (limit loads per flight
     point), ``correlated`` (root bending moment against root torque, only when both are loads)
-    and ``critical_gusts`` (time histories of the critical gusts); ``which``: those to draw.
-    See :mod:`aeroservo.studies.gust_plots`."""
-    from . import gust_plots
+    ``critical_gusts`` (time histories of the critical gusts) and ``spanwise`` (limit loads along
+    the span, only with loads at two or more stations); ``which``: those to draw. See
+    :mod:`aeroservo.studies.gust_plots` and :mod:`aeroservo.studies.gust_span_plots`."""
+    from . import gust_plots, gust_span_plots
 
     draw = {
         "envelope": gust_plots.plot_envelope,
         "correlated": lambda r: gust_plots.plot_correlated(r, *CORRELATED),
         "critical_gusts": gust_plots.plot_critical_gusts,
+        "spanwise": gust_span_plots.plot_spanwise,
     }
-    return {
-        name: draw[name](result)
-        for name in FIGURES
-        if name in which and (name != "correlated" or all(n in result.loads for n in CORRELATED))
+    can = {
+        "correlated": all(n in result.loads for n in CORRELATED),
+        "spanwise": bool(gust_span_plots.span_loads(result)),
     }
+    return {name: draw[name](result) for name in FIGURES if name in which and can.get(name, True)}

@@ -109,8 +109,8 @@ class TunedGustResult:
     peaks_negative : ndarray or None
         As ``peaks`` for the negative gust (closed loop; None open loop: the mirror image).
     limited : dict
-        Closed loop: control -> (n_gradients, 2) largest share of samples at a magnitude or
-        rate limit, for the positive and negative gust (empty open loop).
+        Closed loop: control -> (n_gradients, 2) time [s] at a magnitude or rate limit, for
+        the positive and negative gust (empty open loop).
     histories : dict
         ``(H, sign)`` -> ``(t, gust, y)`` of the critical gusts: times [s], gust velocity
         [m/s true], outputs (n_t, n_loads) in the order of ``loads``.
@@ -340,7 +340,7 @@ def tuned_gust_loads(
             histories[(h, sign)] = (t, sign * amplitude(h) * _gust_at(t, speed, h, march), y)
     limited = {}
     for c in getattr(march, "controls", ()):
-        limited[c] = np.array([[max(run(h, s)[1][c]) for s in signs] for h in grid])
+        limited[c] = np.array([[run(h, s)[1][c] for s in signs] for h in grid])
     amps = np.array([amplitude(h) for h in grid])
     return TunedGustResult(
         speed,

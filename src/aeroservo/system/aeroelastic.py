@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -61,6 +62,10 @@ class AeroelasticModel:
         Aerodynamic model: 2-D strip theory with Wagner lag states (default), or the
         doublet-lattice method with a rational-function approximation (``"dlm"`` with default
         settings, or :class:`aeroservo.aero.dlm_settings.DoubletLattice`; ``docs/dlm.md``).
+    load_stations : sequence of float
+        Spanwise stations [m] where loads are wanted: the mesh gets a node at each (with
+        ``n_elements`` kept), so that ``shear_at_<x>``, ``bending_moment_at_<x>`` and
+        ``torque_at_<x>`` are outputs (any node's loads are).
 
     Notes
     -----
@@ -79,6 +84,7 @@ class AeroelasticModel:
         *,
         sweep_terms: str = "full",
         aero: object = "strip",
+        load_stations: Sequence[float] = (),
     ):
         if not isinstance(wing, Wing):
             raise InputError(f"wing = {wing!r}: expected an aeroservo.Wing")
@@ -86,7 +92,19 @@ class AeroelasticModel:
         self.n_elements = check_int("n_elements", n_elements, lo=1, hi=MAX_ELEMENTS)
         self.wagner: IndicialSet = wagner_set(wagner)
         self.damping = NO_DAMPING if damping is None else damping
-        self.mesh: Mesh = build_mesh(wing, self.n_elements)
+        if isinstance(load_stations, (str, bytes)) or not hasattr(load_stations, "__iter__"):
+            raise InputError(
+                f"load_stations = {load_stations!r}: expected a list of spanwise stations [m]"
+            )
+        self.load_stations = tuple(
+            sorted(
+                {
+                    check_number("load_stations", x, unit="m", lo=0.0, hi=wing.span)
+                    for x in load_stations
+                }
+            )
+        )
+        self.mesh: Mesh = build_mesh(wing, self.n_elements, self.load_stations)
         self.sweep_terms = check_sweep_terms(sweep_terms)
         am = assemble(wing, self.mesh, sweep_terms=self.sweep_terms)
         self.matrices: AeroMatrices = replace(am, Cs=damping_matrix(self.damping, am.Ms, am.Ks))

@@ -131,14 +131,18 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
     n_n = mesh.n_nodes
     lag_dofs = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
 
+    crows = cut_rows(mesh)
+
     def split(blocks, rows, cols, shape):
-        """Scatter, then split extended structural rows/columns into free and root parts."""
+        """Scatter, then split extended structural rows/columns into free and reaction parts:
+        ``(root rows, cut rows)`` when ``rows`` are the structural unknowns."""
         blocks = to_nodal(blocks, kinks, rows is edofs, cols is edofs)  # a cranked axis
         full = scatter_blocks(blocks, rows, cols, shape)
         if cols is edofs:
             full = full[:, :n_q]
         if rows is edofs:
-            return full[:n_q], full[n_q:]
+            cut = scatter_blocks(blocks, crows, cols, (3 * n_n, shape[1]))
+            return full[:n_q], (full[n_q:], cut[:, :n_q] if cols is edofs else cut)
         return full, None
 
     def qq(coef, left=N, right=N):
@@ -158,7 +162,8 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
         dm = sp.diags(mask)
         parts[f"flap ({cs.name})"] = (dm @ flap_all @ dm).tocsr()
     Ks = parts["bending"] + parts["torsion"] + flap_all
-    Ks_r = parts_r["bending"] + parts_r["torsion"]  # flap unknowns are never clamped
+    # flap unknowns are never clamped; a cut of the wing box carries no flap strain
+    Ks_r = tuple(parts_r["bending"][i] + parts_r["torsion"][i] for i in (0, 1))
 
     # circulatory matrices and load vectors grouped by semichord (exact C(k), gusts)
     groups, groups_r = [], []
@@ -168,13 +173,19 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
         pq, pq_r = qq(c["Pq"] * sel)
         if c["Pg"] is not None:
             pg, pg_r = qq(c["Pg"] * sel, N, N1)
-            pq, pq_r = pq + pg, pq_r + pg_r
+            pq, pq_r = pq + pg, tuple(x + y for x, y in zip(pq_r, pg_r, strict=True))
         pd, pd_r = qq(c["Pd"] * sel)
-        gw = to_nodal(elem(N, c["w"][:, :, None] * sel, nz), kinks, True, False)
-        gw = scatter_blocks(gw, edofs, lag_dofs, (n_x, n_n))
-        gw = np.asarray(gw.sum(axis=1)).ravel()  # lag shape functions sum to one
-        groups.append(StripGroup(float(b), pq, pd, gw[:n_q]))
-        groups_r.append(StripGroup(float(b), pq_r, pd_r, gw[n_q:]))
+        gw_blocks = to_nodal(elem(N, c["w"][:, :, None] * sel, nz), kinks, True, False)
+        # lag shape functions sum to one
+        gw = np.asarray(scatter_blocks(gw_blocks, edofs, lag_dofs, (n_x, n_n)).sum(axis=1))
+        gw_c = np.asarray(scatter_blocks(gw_blocks, crows, lag_dofs, (3 * n_n, n_n)).sum(axis=1))
+        groups.append(StripGroup(float(b), pq, pd, gw.ravel()[:n_q]))
+        groups_r.append(
+            tuple(
+                StripGroup(float(b), pq_r[i], pd_r[i], g)
+                for i, g in enumerate((gw.ravel()[n_q:], gw_c.ravel()))
+            )
+        )
 
     # lag fields: term-independent base matrices on the nodes
     Mz1 = scatter_blocks(elem(nz, ones_z, nz), lag_dofs, lag_dofs, (n_n, n_n))
@@ -189,20 +200,23 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
     Knc, Knc_r = qq(c["Knc"])
 
     labels = tuple(str(i) for i in range(n_n))
-    root = AeroMatrices(
-        Ms=Ms_r,
-        Ks=Ks_r,
-        Mnc=Mnc_r,
-        Cnc=Cnc_r,
-        Knc=Knc_r,
-        circ_groups=tuple(groups_r),
-        Mz1=Mz1,
-        Lz1=Lz1,
-        E1=E1,
-        F1=F1,
-        W1=W1_r,
-        dof_labels=mesh.dof_labels,
-        lag_labels=labels,
+    root, cuts = (
+        AeroMatrices(
+            Ms=Ms_r[i],
+            Ks=Ks_r[i],
+            Mnc=Mnc_r[i],
+            Cnc=Cnc_r[i],
+            Knc=Knc_r[i],
+            circ_groups=tuple(g[i] for g in groups_r),
+            Mz1=Mz1,
+            Lz1=Lz1,
+            E1=E1,
+            F1=F1,
+            W1=W1_r[i],
+            dof_labels=mesh.dof_labels,
+            lag_labels=labels,
+        )
+        for i in (0, 1)
     )
     return AeroMatrices(
         Ms=Ms,
@@ -220,6 +234,7 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
         lag_labels=labels,
         stiffness_parts=parts,
         root=root,
+        cuts=cuts,
     )
 
 
@@ -230,6 +245,18 @@ def extended_dofs(mesh: Mesh) -> np.ndarray:
     edofs = mesh.element_dofs.copy()
     edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
     return edofs
+
+
+def cut_rows(mesh: Mesh) -> np.ndarray:
+    """Element unknowns numbered as the rows of the internal loads at each node: the
+    ``(w, theta, phi)`` of an element's inboard node ``j`` become rows ``3j, 3j + 1, 3j + 2``,
+    every other unknown is dropped (-1). Scattered with these rows, the elements outboard of a
+    node give the loads the inboard part carries there (shear, bending moment, torque): the
+    reactions of the outboard part clamped at that node, as the root rows for the root."""
+    rows = np.full(mesh.element_dofs.shape, -1)
+    j = np.arange(mesh.n_elements)
+    rows[:, 0], rows[:, 1], rows[:, 4] = 3 * j, 3 * j + 1, 3 * j + 2
+    return rows
 
 
 def _unit(i: int) -> np.ndarray:

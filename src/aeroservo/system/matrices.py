@@ -63,6 +63,9 @@ class AeroMatrices:
     root : AeroMatrices or None
         The same matrices restricted to the rows of the clamped root unknowns ``(w, theta,
         phi)`` (3 rows each): the root reactions are ``Ks q + Ms qdd - f_aero`` on those rows.
+    cuts : AeroMatrices or None
+        The same for a cut at every node j (rows ``3j .. 3j + 2``, from the elements outboard
+        of it): the shear, bending moment and torque the wing carries there (zero at the tip).
     basis : ndarray (n_full, n_q) or None
         Set when the structural unknowns are modal coordinates ``q_full = basis @ q``.
     """
@@ -83,6 +86,7 @@ class AeroMatrices:
     stiffness_parts: dict = field(default_factory=dict)
     Cs: sp.csr_matrix | None = None
     root: AeroMatrices | None = None
+    cuts: AeroMatrices | None = None
     basis: np.ndarray | None = None
 
     @property
@@ -105,6 +109,32 @@ class AeroMatrices:
     def Gw(self) -> np.ndarray:
         """Total circulatory load distribution (all strips)."""
         return sum(g.Gw for g in self.circ_groups)
+
+    def reaction_rows(self, nodes: tuple[int, ...] = ()) -> AeroMatrices:
+        """The root rows, then the cut rows of each node in ``nodes`` (3 per node): the
+        matrices of the internal loads at the root and at those nodes."""
+        if not nodes:
+            return self.root
+        idx = np.concatenate([[3 * j, 3 * j + 1, 3 * j + 2] for j in nodes])
+        rt, cut = self.root, self.cuts
+
+        def stack(a, b):
+            return sp.vstack([a, sp.csr_matrix(b)[idx]]).tocsr()
+
+        groups = tuple(
+            StripGroup(g.b, stack(g.Pq, h.Pq), stack(g.Pd, h.Pd), np.r_[g.Gw, h.Gw[idx]])
+            for g, h in zip(rt.circ_groups, cut.circ_groups, strict=True)
+        )
+        return replace(
+            rt,
+            Ms=stack(rt.Ms, cut.Ms),
+            Ks=stack(rt.Ks, cut.Ks),
+            Mnc=stack(rt.Mnc, cut.Mnc),
+            Cnc=stack(rt.Cnc, cut.Cnc),
+            Knc=stack(rt.Knc, cut.Knc),
+            W1=stack(rt.W1, cut.W1),
+            circ_groups=groups,
+        )
 
     def project(self, basis: np.ndarray, labels: tuple[str, ...] | None = None) -> AeroMatrices:
         """Galerkin projection of the structural unknowns onto ``q = basis @ eta``.
@@ -130,10 +160,11 @@ class AeroMatrices:
         groups = tuple(
             StripGroup(g.b, both(g.Pq), both(g.Pd), phi.T @ g.Gw) for g in self.circ_groups
         )
-        root = None
-        if self.root is not None:
-            rt = self.root
-            root = replace(
+
+        def rows(rt):
+            if rt is None:
+                return None
+            return replace(
                 rt,
                 Ms=cols(rt.Ms),
                 Ks=cols(rt.Ks),
@@ -162,7 +193,8 @@ class AeroMatrices:
             dof_labels=labels or tuple(f"eta_{j + 1}" for j in range(r)),
             stiffness_parts={k: both(v) for k, v in self.stiffness_parts.items()},
             Cs=None if self.Cs is None else both(self.Cs),
-            root=root,
+            root=rows(self.root),
+            cuts=rows(self.cuts),
             basis=full,
         )
 
@@ -199,7 +231,8 @@ def without_strip_aero(am: AeroMatrices) -> AeroMatrices:
     """``am`` with its strip aerodynamic matrices replaced by :class:`StripOnly` (structure
     kept): the matrices of a model whose aerodynamics is not strip theory."""
     names = ("Mnc", "Cnc", "Knc", "circ_groups", "Mz1", "Lz1", "E1", "F1", "W1")
-    root = None
-    if am.root is not None:
-        root = replace(am.root, **{k: StripOnly(k) for k in names})
-    return replace(am, root=root, **{k: StripOnly(k) for k in names})
+    root, cuts = (
+        None if rt is None else replace(rt, **{k: StripOnly(k) for k in names})
+        for rt in (am.root, am.cuts)
+    )
+    return replace(am, root=root, cuts=cuts, **{k: StripOnly(k) for k in names})
