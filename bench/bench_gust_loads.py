@@ -6,6 +6,8 @@ Goland wing with aileron, 10 elements, sea level, 0.9 V_f, the LQR loop of
 * a 10-gradient x 2-sign tuned-gust search (no refinement), open and closed loop: < 2 s;
 * the turbulence A-bar and N0 of every load at one flight point, open and closed loop: < 0.5 s;
 * the same search refined (the default), for information;
+* a gust-loads study at one flight point (open and closed loop, tuned gusts and turbulence)
+  with 5 load stations against the same study with the root loads only: < 1.5 x (issue 38);
 * baseline: one open-loop flutter boundary of the same model (``flutter_boundary``), reported
   as the ratio of each figure to it.
 """
@@ -62,6 +64,8 @@ def main() -> None:
         median(lambda: turbulence_response(plant, LOADS, controller=ctrl), 5) if closed_ok else None
     )
 
+    t_root, t_span = _stations(sc, quick)
+
     print("aeroservo gust loads (10-element Goland with aileron, 0.9 V_f, LQR at 1 kHz, medians)")
     print(f"  baseline: one flutter boundary:              {base * 1e3:8.1f} ms")
     for label, t, target in (
@@ -77,6 +81,40 @@ def main() -> None:
             continue
         goal = f"  target < {target:g} s: {'PASS' if t < target else 'FAIL'}" if target else ""
         print(f"  {label:44s} {t:7.3f} s = {t / base:6.1f} x boundary{goal}")
+    ratio = t_span / t_root
+    print(
+        f"  {'study, 5 load stations vs the root only':44s} {ratio:7.2f} x"
+        f"  ({t_root:.2f} s, {t_span:.2f} s)  target < 1.5 x: {'PASS' if ratio < 1.5 else 'FAIL'}"
+    )
+
+
+def _stations(sc, quick: bool) -> tuple[float, float]:
+    """Wall time of one flight point of a study with the root loads, then with 5 stations."""
+    from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
+    from aeroservo.studies.gust_point import evaluate_point
+
+    def study(stations):
+        return GustLoadsStudy(
+            mass_cases={"nominal": sc.wing},
+            points=(FlightPoint(0.0, 100.0, "V_C", "nominal"),),
+            loads=("root_shear", "root_bending_moment", "root_torque"),
+            load_stations=stations,
+            controls=sc.controls,
+            sensors=sc.sensors,
+            outputs=sc.outputs,
+            controller=sc.controller,
+            design_speed_factor=1.1,
+            n_gradients=5 if quick else 10,
+        )
+
+    plain, span = study(()), study((1.2192, 2.4384, 3.048, 3.6576, 4.8768))
+    evaluate_point(plain, plain.points[0])  # the controller designed once per study: not timed
+    evaluate_point(span, span.points[0])
+    n = 1 if quick else 3
+    return (
+        median(lambda: evaluate_point(plain, plain.points[0]), n),
+        median(lambda: evaluate_point(span, span.points[0]), n),
+    )
 
 
 if __name__ == "__main__":

@@ -85,6 +85,8 @@ def gust_loads_table(gl: Table, base: Path, wing) -> dict:
             "mass_cases",
             "v_c",
             "v_d",
+            "aircraft_mass",
+            "lift_share",
         ),
     )
     stations = gl.numbers("stations", [], unit="m", lo=0.0, hi=wing.span, increasing=True)
@@ -103,7 +105,12 @@ def gust_loads_table(gl: Table, base: Path, wing) -> dict:
         out[key] = gl.number(key, None, unit="m/s EAS", lo=0.0, lo_open=True, hi=1000.0)
     if out["v_c"] is not None and out["v_d"] is not None and out["v_d"] <= out["v_c"]:
         gl.fail("v_d", out["v_d"], f"must exceed v_c = {out['v_c']:g} m/s EAS")
-    out["mass_cases"] = _mass_cases(gl, base, wing)
+    masses: dict = {}
+    out["mass_cases"] = _mass_cases(gl, base, wing, masses)
+    if gl.has("aircraft_mass"):  # the airplane in the nominal case: 1 g loads (trim)
+        masses[NOMINAL] = gl.number("aircraft_mass", unit="kg", lo=0.0, lo_open=True, hi=1e7)
+    out["aircraft_mass"] = masses
+    out["lift_share"] = gl.number("lift_share", 0.5, lo=0.0, lo_open=True, hi=1.0)
     out["points"] = _points(gl, out["mass_cases"], out["v_c"], out["v_d"])
     return out
 
@@ -121,9 +128,9 @@ def _weights(wt: Table) -> dict:
     return w
 
 
-def _mass_cases(gl: Table, base: Path, wing) -> dict:
+def _mass_cases(gl: Table, base: Path, wing, masses: dict) -> dict:
     """``nominal`` (the ``[wing]``) and each ``[[gust_loads.mass_cases]]`` (``name``, ``wing``
-    a wing file relative to the scenario)."""
+    a wing file relative to the scenario, ``aircraft_mass`` [kg] into ``masses``)."""
     from .wing_file import load_wing
 
     cases = {NOMINAL: wing}
@@ -134,7 +141,7 @@ def _mass_cases(gl: Table, base: Path, wing) -> dict:
         gl.fail("mass_cases", items, "expected [[gust_loads.mass_cases]] tables (name, wing)")
     for i, item in enumerate(items):
         mc = Table(item, f"{gl.key_name('mass_cases')}[{i}]", gl.file)
-        mc.check_keys(("name", "wing"))
+        mc.check_keys(("name", "wing"), ("aircraft_mass",))
         name = mc.string("name", required=True)
         if not name.strip() or not name.isprintable():
             mc.fail("name", name, "expected a printable, non-blank name")
@@ -144,6 +151,8 @@ def _mass_cases(gl: Table, base: Path, wing) -> dict:
         path = mc.path("wing", base, required=True)
         if not is_file(path):
             mc.fail("wing", mc.data["wing"], f"no such wing file ({path})")
+        if mc.has("aircraft_mass"):
+            masses[name] = mc.number("aircraft_mass", unit="kg", lo=0.0, lo_open=True, hi=1e7)
         try:
             cases[name] = load_wing(path)[0]
         except InputError as exc:
@@ -195,6 +204,16 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
     g = s.gust_loads
     gl, sg = top.table("gust_loads"), top.table("signals")
     spec = s.controller if s.controller is not None and s.controller.type != "none" else None
+    if s.aero is not None and s.aero != "strip":
+        for key in ("stations", "aircraft_mass"):
+            if g[key]:
+                gl.fail(
+                    key,
+                    gl.data.get(key, "(a mass case's)"),
+                    "needs the strip model "
+                    "(loads along the span and the wing's weight); the doublet lattice "
+                    "gives root loads only",
+                )
     for case, wing in g["mass_cases"].items():
         where = "" if case == NOMINAL else f" (mass case {case!r})"
         aero = "strip" if s.aero is None else s.aero

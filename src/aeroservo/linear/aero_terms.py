@@ -53,6 +53,9 @@ class AeroTerms:
         Structural stiffness and damping in the unknowns.
     root_Ks, root_Ms : ndarray (n_r, n_q)
         Root (and cut) rows of the structural stiffness and mass.
+    weight, root_weight : ndarray (n_q,), (n_r,) or None
+        Loads of a unit upward acceleration of every mass (``M r``) on the unknowns and on
+        the root (and cut) rows (None: the doublet lattice).
     gust_labels : tuple of str
     """
 
@@ -71,6 +74,8 @@ class AeroTerms:
     root_Ks: np.ndarray
     root_Ms: np.ndarray
     gust_labels: tuple
+    weight: np.ndarray | None = None
+    root_weight: np.ndarray | None = None
 
     @property
     def n_q(self) -> int:
@@ -189,4 +194,6 @@ def strip_terms(
         root_Ks=_dense(rt.Ks),
         root_Ms=_dense(rt.Ms),
         gust_labels=tuple(g_states),
+        weight=am.weight,
+        root_weight=rt.weight,
     )

@@ -8,6 +8,9 @@ Inputs (by name; ``<s>`` is a control-surface name):
 * ``<s>_command`` [rad] - commanded surface rotation: the actuator springs pull the surface
   towards the (servo-filtered) command, ``k_act (delta_c - delta(x_a))`` at each actuator.
 * ``gust`` [m/s] - vertical gust velocity, positive up, uniform along the span.
+* ``load_factor`` [-] - vertical load factor n_z: every mass of the wing loaded by ``n_z g``
+  downward (its weight in 1 g flight; the inertia of the airplane's vertical acceleration
+  otherwise), standard gravity g = 9.80665 m/s^2; strip model only.
 * ``<a>_nonlinear_moment`` [N m] - moment at actuator ``<a>`` alone (a nonlinear hinge's).
 
 Outputs (by name, or :class:`Sensor` for any point):
@@ -105,7 +108,7 @@ class Sensor:
 @dataclass(frozen=True)
 class InputDef:
     name: str
-    kind: str  # "hinge_moment" | "command" | "gust" | "element"
+    kind: str  # "hinge_moment" | "command" | "gust" | "element" | "load_factor"
     surface: int | None
     unit: str
     actuator: int | None = None
@@ -135,6 +138,7 @@ def input_names(wing) -> dict[str, InputDef]:
             name = f"{a.name}_nonlinear_moment"
             out[name] = InputDef(name, "element", k, "N m", actuator=j)
     out["gust"] = InputDef("gust", "gust", None, "m/s")
+    out["load_factor"] = InputDef("load_factor", "load_factor", None, "-")
     return out
 
 

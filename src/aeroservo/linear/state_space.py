@@ -37,7 +37,10 @@ from .servo import Servo, servos_of
 from .signals import Sensor, describe, output_units, resolve_inputs, resolve_outputs
 from .tags import system_name, tag
 
-__all__ = ["Servo", "StateSpaceBuilder", "MAX_SPEED", "DENSITIES"]
+__all__ = ["Servo", "StateSpaceBuilder", "MAX_SPEED", "DENSITIES", "STANDARD_GRAVITY"]
+
+STANDARD_GRAVITY = 9.80665
+"""g [m/s^2] of the ``load_factor`` input (ISO 80000-3)."""
 
 MAX_SPEED = RANGES["airspeed"].hi
 """Largest airspeed [m/s] of a state-space model."""
@@ -123,6 +126,11 @@ class StateSpaceBuilder:
         has_gust = any(d.kind == "gust" for d in self.inputs)
         cuts = tuple(dict.fromkeys(o.node for o in self.outputs if o.kind == "cut"))
         if model.dlm is not None:
+            if any(d.kind == "load_factor" for d in self.inputs):
+                raise InputError(
+                    "input 'load_factor': the wing's weight is modelled with the strip model "
+                    "only (aero = 'strip')"
+                )
             if cuts:
                 raise InputError(
                     "outputs <quantity>_at_<x>: loads along the span need the strip model; "
@@ -168,6 +176,10 @@ class StateSpaceBuilder:
             Fu[:, :, j] = terms.Fu
             Fru[:, :, j] = terms.Fru
         g_states = list(terms.gust_labels)
+        if "load_factor" in col:  # n g downward on every mass: -g n (M r) on every row
+            j = col["load_factor"]
+            B[0, iv, j] = -STANDARD_GRAVITY * terms.weight
+            Fru[0, :, j] = -STANDARD_GRAVITY * terms.root_weight
 
         # control inputs and servo states
         s_next = n_a

@@ -12,8 +12,9 @@ CS-25.341(b) (:func:`~aeroservo.studies.turbulence.turbulence_response`), open l
 controller. :func:`~aeroservo.studies.gust_run.run_gust_loads` runs the tasks in this process or
 on Dask.
 
-The strip model is a cantilever wing clamped at the root: no rigid-body modes, no 1 g load;
-every load is the increment of the clamped wing (``docs/gust-loads.md``).
+The strip model is a cantilever wing clamped at the root: no rigid-body modes; every gust load
+is the increment of the clamped wing, and the 1 g loads are added when ``aircraft_mass`` is
+given (``docs/gust-loads.md``).
 """
 
 from __future__ import annotations
@@ -119,6 +120,12 @@ class GustLoadsStudy:
     aero : {"strip", "dlm"}, DoubletLattice or None
         Aerodynamic model of every mass case (None: strip theory; the doublet lattice at
         Mach 0, as the control loop is built).
+    aircraft_mass : dict
+        Mass case name -> the airplane's mass [kg] in it: that case gets its 1 g loads from
+        the wing's static aeroelastic trim to carry ``lift_share`` of the weight
+        (:mod:`~aeroservo.studies.one_g`), and total limit loads 1 g +- increment.
+    lift_share : float
+        Share of the airplane's weight the wing carries in 1 g flight (0.5: one of two wings).
     v_c, v_d : float or None
         Design cruising and dive speeds [m/s EAS]. With both, a flight point named ``""``
         between them gets U_sigma interpolated linearly between its V_C and V_D values
@@ -156,6 +163,8 @@ class GustLoadsStudy:
     aero: object = None
     v_c: float | None = None
     v_d: float | None = None
+    aircraft_mass: dict = field(default_factory=dict)
+    lift_share: float = 0.5
 
     def __post_init__(self) -> None:
         from ..aero.dlm_settings import as_aero
@@ -183,6 +192,13 @@ class GustLoadsStudy:
             raise InputError("gust loads: a controller needs its controls (signals.controls)")
         check_int("n_gradients", self.n_gradients, lo=3)
         self._check_design_speeds()
+        for case, mass in self.aircraft_mass.items():
+            if case not in self.mass_cases:
+                raise InputError(
+                    f"aircraft_mass: {case!r} is not a mass case; they are {list(self.mass_cases)}"
+                )
+            check_number(f"aircraft_mass[{case!r}]", mass, unit="kg", lo=0.0, lo_open=True)
+        check_number("lift_share", self.lift_share, lo=0.0, lo_open=True, hi=1.0)
         if self.f_g is None:
             w = self.weights
             for k in ("mlw", "mzfw", "mtow", "z_mo"):
@@ -211,6 +227,13 @@ class GustLoadsStudy:
                     f"flight point {p.label}: speed = {p.speed:g} m/s EAS is beyond v_d = "
                     f"{vd:g} m/s EAS (the design envelope ends at V_D)"
                 )
+
+    def one_g_lift(self, mass_case: str) -> float | None:
+        """The lift [N] the wing carries in 1 g flight in a mass case (None: not given)."""
+        from ..linear.state_space import STANDARD_GRAVITY
+
+        mass = self.aircraft_mass.get(mass_case)
+        return None if mass is None else self.lift_share * mass * STANDARD_GRAVITY
 
     def turbulence_factor(self, point: FlightPoint) -> float:
         """Factor on the V_C value of U_sigma at ``point``: 1 up to V_C, 1/2 at V_D, linear

@@ -12,6 +12,7 @@ import numpy as np
 from ..aero.gust_rules import GRADIENT_RANGE, design_gust_velocity, gust_tas
 from ..errors import InputError
 from .gust_loads import FlightPoint, GustLoadsStudy
+from .one_g import one_g_loads
 from .rigid_gust import rigid_gust_loads
 
 __all__ = ["PointLoads", "design_point", "evaluate_point", "in_state_basis"]
@@ -35,6 +36,10 @@ class PointLoads:
         unstable or absent).
     notes : list of str
         What could not be computed and why.
+    one_g : dict
+        1 g loads per load (the static aeroelastic trim, :mod:`~aeroservo.studies.one_g`;
+        empty without the mass case's airplane mass), and ``trim`` its angle of attack, lift
+        and weight.
     rigid : dict
         The rigid clamped wing's quasi-static load in the largest design gust, per root and
         station load (:func:`~aeroservo.studies.rigid_gust.rigid_gust_loads`).
@@ -51,6 +56,8 @@ class PointLoads:
     notes: list = field(default_factory=list)
     elapsed: float = 0.0
     rigid: dict = field(default_factory=dict)
+    one_g: dict = field(default_factory=dict)
+    trim: dict = field(default_factory=dict)
 
 
 _DESIGNED: dict = {}
@@ -177,6 +184,12 @@ def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
         point.altitude,
     )
     res.rigid = rigid_gust_loads(study.mass_cases[point.mass_case], study.loads, rho, v, u_max)
+    lift = study.one_g_lift(point.mass_case)
+    if lift is not None:
+        try:
+            res.one_g, res.trim = one_g_loads(loop.model, rho, v, study.loads, lift)
+        except InputError as exc:
+            res.notes.append(str(exc))
     loops: dict = {"open": None}
     if study.controller is not None:
         ctrl, reference = design_point(study)

@@ -12,6 +12,9 @@ Definitions:
   discrete gusts (incremental);
 * turbulence limit load: ``U_sigma A_bar``;
 * limit load: the larger of the two;
+* 1 g load (with the airplane's mass of the mass case): the static aeroelastic trim of the
+  wing (:mod:`~aeroservo.studies.one_g`); total limit loads ``1 g + max(discrete max,
+  U_sigma A_bar)`` and ``1 g + min(discrete min, -U_sigma A_bar)``;
 * rigid ratio (root and station shear, bending moment, torque): the discrete limit load over
   the rigid clamped wing's quasi-static load in the largest design gust
   (:mod:`~aeroservo.studies.rigid_gust`), a check: near 1 for a stiff wing in a long gust;
@@ -27,96 +30,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from .gust_records import totals
 
-__all__ = ["GustLoadsResult", "point_records", "RAISE_TOLERANCE"]
+__all__ = ["GustLoadsResult", "RAISE_TOLERANCE"]
 
 RAISE_TOLERANCE = 1e-3
 """Relative increase of a limit load above which the loop is said to raise it (0.1 %: ten
 times the accuracy of the sampled march against the exact one, ``docs/gust-loads.md``)."""
-
-
-def _extreme_record(e, turb, u_sig: float, rigid: float | None = None) -> dict:
-    rec = {"unit": e.unit}
-    for side in ("max", "min"):
-        value, h, t, sign, corr = e.side(side)
-        rec.update(
-            {
-                side: value,
-                f"{side}_gradient": h,
-                f"{side}_time": t,
-                f"{side}_sign": sign,
-                f"{side}_correlated": dict(corr),
-            }
-        )
-    rec["discrete"] = max(abs(e.maximum), abs(e.minimum))
-    if rigid is not None:
-        rec["rigid"] = rigid
-    if turb is not None and e.load in turb.a_bar:
-        rec.update(
-            a_bar=turb.a_bar[e.load], n0=turb.n0[e.load], turbulence=u_sig * turb.a_bar[e.load]
-        )
-    return rec
-
-
-def point_records(index: int, pl, loads) -> tuple[list[dict], dict]:
-    """JSON records and history arrays of one :class:`~aeroservo.studies.gust_point.PointLoads`
-    (``index``: its place in the study); the records keep ``loads`` and the controls applied,
-    the histories every output."""
-    p = pl.point
-    base = {
-        "point": index,
-        "mass_case": p.mass_case,
-        "altitude": p.altitude,
-        "speed_name": p.speed_name,
-        "eas": p.speed,
-        "tas": p.tas,
-        "density": p.density,
-        "f_g": pl.f_g,
-        "u_sigma": pl.u_sigma,
-        "open_loop_stable": pl.open_loop_stable,
-        "notes": list(pl.notes),
-        "elapsed": pl.elapsed,
-    }
-    records, arrays = [], {}
-    for loop, d in pl.discrete.items():
-        turb = pl.turbulence.get(loop)
-        rec = dict(base, loop=loop, controller=d.controller, gust_speed=d.speed)
-        keep = [n for n in d.extremes if n in loads or n in d.limited]
-        rec["loads"] = {
-            n: _extreme_record(d.extremes[n], turb, pl.u_sigma, pl.rigid.get(n)) for n in keep
-        }
-        rec["time_at_limit"] = {c: float(np.max(a)) for c, a in d.limited.items()}
-        rec["gradients"] = [float(h) for h in d.gradients]
-        neg = d.peaks_negative if d.peaks_negative is not None else -d.peaks[:, :, ::-1]
-        rec["tuning"] = {  # peak of each load over time per scanned gradient, both gust signs
-            n: {
-                "up_max": d.peaks[:, i, 0].tolist(),
-                "up_min": d.peaks[:, i, 1].tolist(),
-                "down_max": neg[:, i, 0].tolist(),
-                "down_min": neg[:, i, 1].tolist(),
-            }
-            for i, n in enumerate(d.loads)
-            if n in keep
-        }
-        rec["amplitudes"] = [float(a) for a in d.amplitudes]
-        if turb is not None:
-            rec["covariance"] = {
-                "outputs": list(turb.outputs),
-                "matrix": np.asarray(turb.covariance).tolist(),
-            }
-        keys = {}
-        for (h, sign), (t, gust, y) in d.histories.items():
-            key = f"p{index}_{loop}_H{h:.6g}_{'up' if sign > 0 else 'down'}"
-            arrays[key + "_t"], arrays[key + "_gust"], arrays[key + "_y"] = t, gust, y
-            keys[f"{h!r} {sign}"] = key
-        rec["history_loads"] = list(d.loads)
-        rec["histories"] = {
-            name: {s: keys[f"{e.side(s)[1]!r} {e.side(s)[3]}"] for s in ("max", "min")}
-            for name, e in d.extremes.items()
-            if name in keep
-        }
-        records.append(rec)
-    return records, arrays
 
 
 @dataclass
@@ -190,6 +110,7 @@ class GustLoadsResult:
                         "turbulence": turb,
                         "limit": np.nanmax([v["discrete"], turb]),
                         "rigid_ratio": v["discrete"] / v["rigid"] if v.get("rigid") else np.nan,
+                        **totals(v, turb),
                         "time_at_limit_s": max(r["time_at_limit"].values(), default=0.0),
                     }
                 )
@@ -298,11 +219,25 @@ class GustLoadsResult:
             lines.append(f"  {loop} loop, worst limit load (incremental, clamped wing):")
             for load, row in w.iterrows():
                 rec = self.record(int(row["point"]), loop)
+                total = (
+                    f" (1 g {row['one_g']:.5g}: total {row['total_min']:.5g} to "
+                    f"{row['total_max']:.5g})"
+                    if np.isfinite(row.get("one_g", np.nan))
+                    else ""
+                )
                 lines.append(
                     f"    {load:28s} {row['limit']:12.5g} {row['unit']:7s} {row['source']:10s}"
-                    f" at {_point_label(rec)}"
+                    f" at {_point_label(rec)}{total}"
                 )
         seen = set()
+        for r in self.records:
+            t = r.get("trim") or {}
+            if t and r["loop"] == self.loops[0]:
+                lines.append(
+                    f"  1 g trim at {_point_label(r)}: root angle of attack "
+                    f"{np.degrees(t['alpha_rad']):.3f} deg, lift {t['lift_N']:.5g} N, wing weight "
+                    f"{t['weight_N']:.5g} N"
+                )
         for r in self.records:
             for note in r["notes"]:  # a point's notes are in each of its loops' records
                 if (r["point"], note) not in seen:

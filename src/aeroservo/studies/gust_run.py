@@ -9,7 +9,8 @@ import time
 from ..errors import InputError, check_int
 from .gust_loads import GustLoadsStudy
 from .gust_point import PointLoads, design_point, evaluate_point
-from .gust_results import GustLoadsResult, point_records
+from .gust_records import point_records
+from .gust_results import GustLoadsResult
 
 __all__ = ["run_gust_loads"]
 

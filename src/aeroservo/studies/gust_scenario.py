@@ -47,6 +47,8 @@ def gust_study(scenario: Scenario):
         load_stations=tuple(g["stations"]),
         v_c=g.get("v_c"),
         v_d=g.get("v_d"),
+        aircraft_mass=dict(g.get("aircraft_mass", {})),
+        lift_share=g.get("lift_share", 0.5),
         controls=tuple(scenario.controls) if loop else (),
         sensors=tuple(scenario.sensors) if loop else (),
         outputs=tuple(scenario.outputs) if loop else (),
@@ -173,7 +175,8 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
         ],
         "settings": dict(result.settings),
         "units": dict(result.units),
-        "loads_are": "increments of the wing clamped at its root (no rigid-body modes, no 1 g)",
+        "loads_are": "increments of the wing clamped at its root (no rigid-body modes); the 1 g "
+        "loads and the totals in the table when the airplane's mass is given",
     }
     if result.loops == ["open", "closed"]:
         a = result.alleviation

@@ -150,6 +150,12 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
 
     m_blocks = elem(N, ms, N) + point_mass_blocks(wing, mesh)  # + 0.0 without masses
     Ms, Ms_r = split(m_blocks, edofs, edofs, (n_x, n_x))
+    # the loads of a unit vertical acceleration of every point (the wing's weight per g): the
+    # mass blocks applied to a rigid vertical translation (w = 1, no slope, twist or flap)
+    rigid = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    w_el = to_nodal(m_blocks, kinks, True, True) @ rigid
+    weight = _scatter_vector(w_el, edofs, n_x)
+    weight_c = _scatter_vector(w_el, crows, 3 * n_n)
     parts, parts_r = {}, {}
     for i, name in enumerate(("bending", "torsion")):
         parts[name], parts_r[name] = qq(kd * _unit(i), D, D)
@@ -215,6 +221,7 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
             W1=W1_r[i],
             dof_labels=mesh.dof_labels,
             lag_labels=labels,
+            weight=(weight[n_q:], weight_c)[i],
         )
         for i in (0, 1)
     )
@@ -235,6 +242,7 @@ def assemble(wing: Wing, mesh: Mesh, *, sweep_terms: str = "full") -> AeroMatric
         stiffness_parts=parts,
         root=root,
         cuts=cuts,
+        weight=weight[:n_q],
     )
 
 
@@ -245,6 +253,14 @@ def extended_dofs(mesh: Mesh) -> np.ndarray:
     edofs = mesh.element_dofs.copy()
     edofs[0, [0, 1, 4]] = [n_q, n_q + 1, n_q + 2]
     return edofs
+
+
+def _scatter_vector(values: np.ndarray, rows: np.ndarray, n: int) -> np.ndarray:
+    """Sum element vectors (n_el, p) into a vector of length n, dropping removed unknowns."""
+    out = np.zeros(n)
+    keep = rows >= 0
+    np.add.at(out, rows[keep], values[keep])
+    return out
 
 
 def cut_rows(mesh: Mesh) -> np.ndarray:

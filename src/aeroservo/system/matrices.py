@@ -63,6 +63,10 @@ class AeroMatrices:
     root : AeroMatrices or None
         The same matrices restricted to the rows of the clamped root unknowns ``(w, theta,
         phi)`` (3 rows each): the root reactions are ``Ks q + Ms qdd - f_aero`` on those rows.
+    weight : ndarray (n_q,) or None
+        The loads of a unit vertical acceleration of every point of the wing, per unit
+        acceleration [kg] (upward; ``-g weight`` is the wing's weight), ``M r`` with ``r`` the
+        rigid vertical translation; on the reaction rows of ``root`` and ``cuts`` too.
     cuts : AeroMatrices or None
         The same for a cut at every node j (rows ``3j .. 3j + 2``, from the elements outboard
         of it): the shear, bending moment and torque the wing carries there (zero at the tip).
@@ -88,6 +92,7 @@ class AeroMatrices:
     root: AeroMatrices | None = None
     cuts: AeroMatrices | None = None
     basis: np.ndarray | None = None
+    weight: np.ndarray | None = None
 
     @property
     def n_q(self) -> int:
@@ -134,6 +139,7 @@ class AeroMatrices:
             Knc=stack(rt.Knc, cut.Knc),
             W1=stack(rt.W1, cut.W1),
             circ_groups=groups,
+            weight=None if rt.weight is None else np.r_[rt.weight, cut.weight[idx]],
         )
 
     def project(self, basis: np.ndarray, labels: tuple[str, ...] | None = None) -> AeroMatrices:
@@ -196,6 +202,7 @@ class AeroMatrices:
             root=rows(self.root),
             cuts=rows(self.cuts),
             basis=full,
+            weight=None if self.weight is None else phi.T @ self.weight,
         )
 
 
