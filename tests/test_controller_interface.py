@@ -637,6 +637,7 @@ def save_mat(path, mats, Ts, inputs=SENSORS, **change):
 
 def linear_spec(file: str, **keys) -> str:
     text = f'type = "linear"\nname = "brought"\nfile = "{file}"\n'
+    keys = {"sign": 1} | keys  # the compensator's output is the command (python-control's K)
     return text + "".join(f"{k} = {json.dumps(v)}\n" for k, v in keys.items())
 
 
@@ -811,7 +812,7 @@ def test_gain_and_python_controller_files_run_in_a_scenario(setup, tmp_path):
     engaged range, and has no margins."""
     _sc, loop, vf, _ = setup
     gain = (
-        'type = "gain"\nname = "twist gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+        'type = "gain"\nname = "twist gain"\nsign = -1\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
         f"sensors = {json.dumps(list(SENSORS))}\nmatrix = {json.dumps(TWIST_GAIN)}\n"
     )
     (tmp_path / "law.py").write_text(LAW_PY.format(K=TWIST_GAIN))
@@ -881,12 +882,12 @@ def _bad_files(tmp_path, mats):
         (linear_spec("ok.npz", function="f"), ["function", "not used by a controller of type"]),
         ('type = "linear"\n', ["file", "missing"]),
         (
-            'type = "gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+            'type = "gain"\nsign = -1\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
             'sensors = ["tip_twist"]\nmatrix = [[1.0, 2.0]]\n',
             ["gain.matrix", "row 0: expected 1 numbers"],
         ),
         (
-            'type = "gain"\n[gain]\ncontrols = ["aileron_hinge_moment"]\nmatrix = [[1.0]]\n',
+            'type = "gain"\nsign = -1\n[gain]\ncontrols = ["aileron_hinge_moment"]\nmatrix = [[1.0]]\n',
             ["gain.sensors", "give sensors or states"],
         ),
         ('type = "python"\nfile = "law.py"\nfunction = "law"\n', ["file", "law.py"]),
@@ -1009,3 +1010,52 @@ def test_schedule_like_object_is_accepted_or_refused_with_an_input_error(setup, 
         ENTRY_POINTS[entry](setup[1], plant, ScheduleLike())
     except aes.InputError:
         pass
+
+
+def test_one_sign_rule_for_gain_and_linear_files(tmp_path):
+    """Issue 38: a ``gain`` and a ``linear`` file mean the same thing, ``u = sign K y``: the
+    same matrix with the same sign is the same law (its D, the static compensator's only
+    matrix, equal to ``sign K``), and a file without ``sign`` is refused in one line naming
+    the key (a gain file used to mean -1 and a linear one +1 without saying it)."""
+    K = np.array(TWIST_GAIN)
+    np.savez(
+        tmp_path / "k.npz",
+        A=np.zeros((0, 0)),
+        B=np.zeros((0, 3)),
+        C=np.zeros((1, 0)),
+        D=K,
+        dt=DT,
+        inputs=np.array(SENSORS),
+        outputs=np.array(CONTROLS),
+    )
+    gain_text = (
+        'type = "gain"\nname = "g"\nsign = {s}\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+        f"sensors = {json.dumps(list(SENSORS))}\nmatrix = {json.dumps(TWIST_GAIN)}\n"
+    )
+    laws = {}
+    for sign in (1, -1):
+        for kind, text in (
+            ("gain", gain_text.format(s=sign)),
+            ("linear", linear_spec(str(tmp_path / "k.npz"), sign=sign)),
+        ):
+            path = scenario_copy(tmp_path / f"{kind}{sign}", "goland_aileron_hinf", controller=text)
+            _sc, ctrl = _brought(path)
+            laws[kind, sign] = np.asarray(ctrl.law().D)
+        np.testing.assert_array_equal(laws["gain", sign], laws["linear", sign])
+        np.testing.assert_array_equal(laws["gain", sign], sign * K)
+    # the Python interface: static_gain's sign, -1 by default (control.lqr's K)
+    g = static_gain(K, CONTROLS, sensors=SENSORS, sample_rate=RATE)
+    np.testing.assert_array_equal(g.law().D, -K)
+    g = static_gain(K, CONTROLS, sensors=SENSORS, sample_rate=RATE, sign=1)
+    np.testing.assert_array_equal(g.law().D, K)
+    with pytest.raises(aes.InputError, match="sign = 0"):
+        static_gain(K, CONTROLS, sensors=SENSORS, sample_rate=RATE, sign=0)
+    for kind, text in (
+        ("gain", gain_text.replace("sign = {s}\n", "")),
+        ("linear", linear_spec(str(tmp_path / "k.npz")).replace("sign = 1\n", "")),
+    ):
+        path = scenario_copy(tmp_path / f"nosign_{kind}", "goland_aileron_hinf", controller=text)
+        with pytest.raises(
+            aes.InputError, match=r"brought\.toml: sign: .*give sign = 1 .* or sign = -1"
+        ):
+            load_scenario(path)

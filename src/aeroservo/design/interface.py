@@ -174,8 +174,10 @@ def static_gain(
     sensors: Sequence[str] | None = None,
     states: Sequence[str] | None = None,
     sample_rate: float,
+    sign: int = -1,
 ) -> DiscreteCompensator | StateGain:
-    """A static output or state feedback ``u = -K y`` (or ``u = -K x``, the LQR convention).
+    """A static output or state feedback ``u = sign K y`` (or ``u = sign K x``); by default
+    ``u = -K y``, the LQR convention (``control.lqr``'s K). ``docs/conventions.md``.
 
     Parameters
     ----------
@@ -187,11 +189,16 @@ def static_gain(
         The measured sensors, or the plant states, the columns of K refer to (exactly one).
     sample_rate : float
         [Hz]
+    sign : {-1, 1}
+        ``-1`` (default): ``u = -K y``, negative feedback; ``1``: ``u = +K y``, the matrix maps
+        the measurements to the command (as a controller file's ``sign``).
 
     Returns
     -------
     DiscreteCompensator (no state) or StateGain
     """
+    if isinstance(sign, bool) or sign not in (1, -1):
+        raise InputError(f"sign = {describe(sign)}: expected -1 (u = -K y) or 1 (u = +K y)")
     controls = tuple(check_names("controls", controls))
     if (sensors is None) == (states is None):
         raise InputError("static_gain: give either sensors=[...] or states=[...], not both")
@@ -209,10 +216,10 @@ def static_gain(
         raise InputError("K has NaN or infinite entries")
     dt = sample_period(sample_rate)
     if states is not None:
-        return StateGain(G, controls, cols, dt)
+        return StateGain(-sign * G, controls, cols, dt)  # a StateGain is u = -K x
     z = np.zeros
     return DiscreteCompensator(
-        z((0, 0)), z((0, len(cols))), z((len(controls), 0)), -G, controls, cols, dt,
+        z((0, 0)), z((0, len(cols))), z((len(controls), 0)), sign * G, controls, cols, dt,
         source="static output gain",
     )  # fmt: skip
 

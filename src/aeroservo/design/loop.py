@@ -294,7 +294,7 @@ def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
             sample_rate=rate,
             method=c.get("method", "tustin"),
             prewarp=c.get("prewarp"),
-            sign=c.get("sign", 1),
+            sign=c["sign"],
             anti_windup=None
             if c.get("anti_windup", True)
             else np.zeros((sys.nstates, sys.noutputs)),
@@ -309,6 +309,7 @@ def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
             sensors=g.get("sensors"),
             states=g.get("states"),
             sample_rate=rate,
+            sign=g["sign"],
         )
     p = spec.python
     return python_law(

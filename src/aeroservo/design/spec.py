@@ -67,8 +67,8 @@ class ControllerSpec:
         the loop's), ``inputs`` (sensors), ``outputs`` (commands), ``source``, and how to
         bring it: ``method``, ``prewarp`` [Hz], ``sign``, ``anti_windup`` (bool).
     gain : dict or None
-        A static gain ``u = -K y`` (``"gain"``): ``K``, ``controls`` and ``sensors`` or
-        ``states``.
+        A static gain ``u = sign K y`` (``"gain"``): ``K``, ``sign``, ``controls`` and
+        ``sensors`` or ``states``.
     python : dict or None
         A Python law (``"python"``): ``function`` (the callable ``fn(t, y)``), ``sensors``,
         ``needs_state``, ``source``.

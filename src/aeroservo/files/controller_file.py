@@ -72,7 +72,7 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "lqg": ("weights", "estimator"),
         "mpc": ("weights", "estimator", "limits"),
         "hinf": ("weights",),
-        "linear": ("file",),
+        "linear": ("file",),  # and sign, whose absence gets its own line (_sign)
         "gain": ("gain",),
         "python": ("file", "function"),
     }[kind]
@@ -83,7 +83,7 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "mpc": ("weights", "estimator", "limits", "mpc", "margins"),
         "hinf": ("weights", "limits", "hinf", "margins"),
         "linear": ("file", "method", "prewarp", "sign", "anti_windup", "limits", "margins"),
-        "gain": ("gain", "limits", "margins"),
+        "gain": ("gain", "sign", "limits", "margins"),
         "python": ("file", "function", "sensors", "needs_state", "limits"),
     }[kind]
     for key in TOP_KEYS[3:]:
@@ -186,6 +186,7 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
 
 def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
     """The ``linear``, ``gain`` and ``python`` types: a controller designed elsewhere."""
+    sign = _sign(top) if kind in ("gain", "linear") else None
     if kind == "gain":
         g = top.table("gain").check_keys(("controls", "matrix"), ("sensors", "states"))
         if g.has("sensors") == g.has("states"):
@@ -207,6 +208,7 @@ def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
             )
         kw["gain"] = {
             "K": K,
+            "sign": sign,
             "controls": controls,
             ("sensors" if g.has("sensors") else "states"): cols,
         }
@@ -229,11 +231,26 @@ def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
         top.fail("file", top.data["file"], str(exc))
     lin["method"] = top.string("method", "tustin", choices=DISCRETIZATIONS)
     lin["prewarp"] = top.number("prewarp", None, unit="Hz", lo=0.0, lo_open=True, hi=5e4)
-    lin["sign"] = top.integer("sign", 1, lo=-1, hi=1)
-    if lin["sign"] == 0:
-        top.fail("sign", 0, "expected 1 (the output is the command) or -1")
+    lin["sign"] = sign
     lin["anti_windup"] = top.boolean("anti_windup", True)
     kw["linear"] = lin
+
+
+def _sign(top: Table) -> int:
+    """``sign``, required by a ``gain`` and a ``linear`` file: the command is ``u = sign K y``
+    (``+1``: the matrix's or the compensator's output is the command, as MATLAB's hinfsyn and
+    lqgreg give it; ``-1``: negative feedback, as python-control's lqr K and feedback())."""
+    if not top.has("sign"):
+        raise InputError(
+            f"{top.file}: {top.key_name('sign')}: missing; give sign = 1 (u = +K y: the matrix "
+            "or compensator output is the command) or sign = -1 (u = -K y: negative feedback, "
+            "control.lqr's K); older versions read a gain file as -1 and a linear file as +1 "
+            "without saying so (docs/conventions.md)"
+        )
+    sign = top.integer("sign", lo=-1, hi=1)
+    if sign == 0:
+        top.fail("sign", 0, "expected 1 (u = +K y) or -1 (u = -K y)")
+    return sign
 
 
 def python_function(top: Table, path: Path, name: str):

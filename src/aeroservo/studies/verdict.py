@@ -56,8 +56,8 @@ _REMEDIES = {
     "(controller limits.magnitude, limits.rate), a smaller disturbance, or anti-windup "
     "(controller anti_windup)",
     "sign": "the same law with the opposite sign is stable: check the controller's sign (a "
-    "gain file closes u = -K y; a brought compensator u = +y_K, or its negative with "
-    "sign = -1; docs/controllers.md)",
+    "gain or linear file closes u = sign K y: sign = 1 when its output is the command, -1 for "
+    "negative feedback as control.lqr's K; docs/conventions.md)",
 }
 
 
