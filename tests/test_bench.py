@@ -20,7 +20,7 @@ BENCH = Path(__file__).resolve().parents[1] / "bench"
         ("bench_flutter.py", 4),
         ("bench_mpc_step.py", 1),
         ("bench_trade.py", 1),
-        ("bench_gust_loads.py", 4),
+        ("bench_gust_loads.py", 5),
         ("bench_lco.py", 3),
         ("bench_dlm.py", 3),
     ],

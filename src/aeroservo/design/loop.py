@@ -210,6 +210,14 @@ class ControlLoop:
         OpenLoop, StateFeedback, OutputFeedback, GainSchedule, MPCController,
         DiscreteCompensator, StateGain or PythonLaw
         """
+        from .anti_windup import with_anti_windup
+
+        ctrl = self._designed(spec, speed, sample_rate, flutter_speed)
+        on = spec.uses_applied_input
+        return ctrl if on is None else with_anti_windup(ctrl, on)
+
+    def _designed(self, spec: ControllerSpec, speed: float, sample_rate: float, flutter_speed):
+        """The controller of :meth:`design_controller` before its anti-windup is set."""
         self.check_spec(spec)
         rate = check_number("sample_rate", sample_rate, unit="Hz", lo=0.0, lo_open=True)
         if spec.type == "none":
@@ -295,9 +303,6 @@ def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
             method=c.get("method", "tustin"),
             prewarp=c.get("prewarp"),
             sign=c["sign"],
-            anti_windup=None
-            if c.get("anti_windup", True)
-            else np.zeros((sys.nstates, sys.noutputs)),
             source=f"compensator from {c['source']}",
         )
         return ctrl

@@ -16,7 +16,7 @@ flutter boundaries.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -133,6 +133,9 @@ class OutputFeedback:
         Pieces of the continuous LQG (design model ``A, B, C, D``, gains ``K``, ``L``).
     design_speed : float
         Speed of the design model [m/s].
+    applied_input : bool
+        Whether the estimator predicts with the input applied after the actuator limits (the
+        default) or with its own command (``aeroservo.design.anti_windup``).
     """
 
     K: np.ndarray
@@ -143,11 +146,13 @@ class OutputFeedback:
     continuous: dict = field(default_factory=dict)
     design_speed: float = float("nan")
     needs_state: bool = False
+    applied_input: bool = True
 
     def law(self, states=()) -> LinearLaw:
         """Its :class:`~aeroservo.design.law.LinearLaw` (the estimator predicts with the input
-        applied: ``L = Bu``)."""
-        return estimator_law(self.K, self.kf, self.controls, self.sensors, self.dt, "LQG")
+        applied, ``L = Bu``, or with its command, ``L = 0``)."""
+        law = estimator_law(self.K, self.kf, self.controls, self.sensors, self.dt, "LQG")
+        return law if self.applied_input else replace(law, L=np.zeros_like(law.L))
 
     @property
     def compensator(self):
@@ -165,10 +170,11 @@ class OutputFeedback:
         self.kf.reset()
 
     def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
-        return -(self.K @ self.kf.correct(y))
+        self._c = -(self.K @ self.kf.correct(y))
+        return self._c
 
     def update(self, y: np.ndarray, u: np.ndarray) -> None:
-        self.kf.predict(u)
+        self.kf.predict(u if self.applied_input else self._c)
 
 
 @blas_limited

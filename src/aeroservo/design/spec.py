@@ -18,6 +18,15 @@ CONTROLLER_TYPES = ("none", "lqr", "lqg", "mpc", "hinf", "linear", "gain", "pyth
 """Controller file types: designed here (lqr ... hinf) or brought (linear, gain, python)."""
 
 
+ANTI_WINDUP_DEFAULTS = {"lqg": True, "hinf": False, "linear": False}
+"""Default use of the applied input per type, from the recoverable sets of the shipped loops
+(:func:`aeroservo.studies.recovery.recoverable_set`, 9 x 9 grids of tip deflection 1-30 cm x
+hinge-moment limit 200-4000 N m at 1.05 and 1.1 V_f, issue 38): the H-infinity compensator's
+observer-form anti-windup lost 2-3 of 81 cells and never gained one, so a compensator (built-in
+or brought) has it off; the LQG's estimator predicting with the applied input differed by one
+cell of 81 either way, so it keeps the consistent model (on). ``anti_windup`` switches it."""
+
+
 @dataclass(frozen=True)
 class ControllerSpec:
     """How to design a controller.
@@ -72,6 +81,10 @@ class ControllerSpec:
     python : dict or None
         A Python law (``"python"``): ``function`` (the callable ``fn(t, y)``), ``sensors``,
         ``needs_state``, ``source``.
+    anti_windup : bool or None
+        Whether an LQG, an H-infinity or a brought compensator uses the applied input when
+        the limits cut its command (:mod:`aeroservo.design.anti_windup`); None: the measured
+        default of its type (:data:`ANTI_WINDUP_DEFAULTS`).
     source : str
         File the spec was read from.
     """
@@ -97,6 +110,16 @@ class ControllerSpec:
     gain: dict | None = None
     python: dict | None = None
     source: str = "<dict>"
+    anti_windup: bool | None = None
+
+    @property
+    def uses_applied_input(self) -> bool | None:
+        """Whether the designed controller uses the applied input (its anti-windup): the
+        spec's ``anti_windup``, else the measured default of its type
+        (:data:`ANTI_WINDUP_DEFAULTS`); None for a type without the switch."""
+        if self.type not in ANTI_WINDUP_DEFAULTS:
+            return None
+        return ANTI_WINDUP_DEFAULTS[self.type] if self.anti_windup is None else self.anti_windup
 
     @property
     def signals(self) -> dict:

@@ -54,6 +54,16 @@ MAX_SCHEDULE = 50
 """Most design speeds of a gain schedule (each is an LQR/LQG design)."""
 
 
+NO_ANTI_WINDUP = {
+    "lqr": " (a state feedback has no state to wind up)",
+    "gain": " (a static gain has no state to wind up)",
+    "mpc": " (an MPC plans within its limits)",
+    "python": " (a Python law handles its limits itself)",
+    "none": " (an open loop commands nothing)",
+}
+"""Why a type has no ``anti_windup`` switch (:mod:`aeroservo.design.anti_windup`)."""
+
+
 def controller_from_dict(data: object, file: str = "<dict>") -> ControllerSpec:
     """Build a :class:`ControllerSpec` from a parsed controller file."""
     with one_line_errors():
@@ -79,16 +89,17 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
     allowed = {
         "none": ("limits",),
         "lqr": ("weights", "limits", "schedule", "margins"),
-        "lqg": ("weights", "estimator", "limits", "schedule", "margins"),
+        "lqg": ("weights", "estimator", "limits", "schedule", "margins", "anti_windup"),
         "mpc": ("weights", "estimator", "limits", "mpc", "margins"),
-        "hinf": ("weights", "limits", "hinf", "margins"),
+        "hinf": ("weights", "limits", "hinf", "margins", "anti_windup"),
         "linear": ("file", "method", "prewarp", "sign", "anti_windup", "limits", "margins"),
         "gain": ("gain", "sign", "limits", "margins"),
         "python": ("file", "function", "sensors", "needs_state", "limits"),
     }[kind]
     for key in TOP_KEYS[3:]:
         if top.has(key) and key not in allowed:
-            top.fail(key, top.data[key], f"not used by a controller of type {kind!r}")
+            why = NO_ANTI_WINDUP.get(kind, "") if key == "anti_windup" else ""
+            top.fail(key, top.data[key], f"not used by a controller of type {kind!r}{why}")
         if key in needs and not top.has(key):
             raise_missing(top, key, kind)
 
@@ -143,6 +154,9 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         delay_ms=mg.number("delay_ms", None, unit="ms", lo=0.0, hi=1e4),
         at=tuple(at),
     )
+
+    if top.has("anti_windup"):  # lqg, hinf, linear (others refused above)
+        kw["anti_windup"] = top.boolean("anti_windup")
 
     lim = top.table("limits").check_keys((), ("magnitude", "rate"))
     kw["limits"] = Limits(
@@ -232,7 +246,6 @@ def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
     lin["method"] = top.string("method", "tustin", choices=DISCRETIZATIONS)
     lin["prewarp"] = top.number("prewarp", None, unit="Hz", lo=0.0, lo_open=True, hi=5e4)
     lin["sign"] = sign
-    lin["anti_windup"] = top.boolean("anti_windup", True)
     kw["linear"] = lin
 
 

@@ -137,6 +137,11 @@ class LoopGustMarch:
         self.controls = tuple(self.controller.controls)
         extra = tuple(c for c in self.controls if c not in sys.output_labels)
         self.outputs = tuple(sys.output_labels) + extra
+        c = self.controller
+        # a linear law with symmetric limits (magnitude +-M, rate +-R) and no noise is an odd
+        # loop: the down gust's response is exactly minus the up gust's (IEEE arithmetic
+        # commutes with negation), so one sign is marched; a nonlinear law marches both
+        self.odd = callable(getattr(c, "law", None)) and getattr(c, "is_linear", True)
 
     def response(self, gradient: float, amplitude: float, duration: float):
         """``(t, y, limited)``: times [s], outputs (n_t, n_outputs) and ``{control: time [s]
