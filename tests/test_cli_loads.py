@@ -264,6 +264,41 @@ BAD = [
         'spec = "../controllers/lqr.toml"\nengaged_speeds = [50.0, 150.0]',
         "controller.engaged_speeds = [50.0, 150.0]: unknown key",
     ),
+    # issue 38: load stations, V_C / V_D, the 1 g trim
+    (
+        "stations = [1.2192, 2.4384, 3.6576, 4.8768]",
+        "stations = [2.4384, 1.2192]",
+        "gust_loads.stations = [2.4384, 1.2192]: values must increase",
+    ),
+    (
+        "stations = [1.2192, 2.4384, 3.6576, 4.8768]",
+        "stations = [1.0, 7.0]",
+        "gust_loads.stations[1] = 7.0: allowed range is [0, 6.096] [m]",
+    ),
+    ("stations = [1.2192, 2.4384, 3.6576, 4.8768]", "stations = []", "gust_loads.stations = []"),
+    (
+        "stations = [1.2192, 2.4384, 3.6576, 4.8768]",
+        'stations = ["root"]',
+        "gust_loads.stations[0] = 'root'",
+    ),
+    ("v_d = 125.0 ", "v_d = 90.0 ", "gust_loads.v_d = 90.0: must exceed v_c = 100 m/s EAS"),
+    ("v_c = 100.0 ", "v_c = 105.0 ", "gust_loads.points[0].speed = 100.0: the point is named V_C"),
+    ("v_c = 100.0 ", "v_c = -1.0 ", "gust_loads.v_c = -1.0: allowed range is (0, 1000]"),
+    (
+        "aircraft_mass = 2000.0 ",
+        "aircraft_mass = 0.0 ",
+        "gust_loads.aircraft_mass = 0.0: allowed range is (0, 1e+07] [kg]",
+    ),
+    (
+        "aircraft_mass = 2000.0 ",
+        "aircraft_mass = 2000.0\nlift_share = 1.5",
+        "gust_loads.lift_share = 1.5: allowed range is (0, 1]",
+    ),
+    (
+        "aircraft_mass = 2000.0 ",
+        'aircraft_mass = "heavy" ',
+        "gust_loads.aircraft_mass = 'heavy'",
+    ),
 ]
 
 

@@ -878,6 +878,18 @@ def _bad_files(tmp_path, mats):
         (linear_spec("k.txt"), ["k.txt", "expected a .npz or .mat file"]),
         (linear_spec("missing.npz"), ["missing.npz", "no such file"]),
         (linear_spec("ok.npz", method="euler"), ["method = 'euler'", "tustin"]),
+        (linear_spec("ok.npz", sign=2), ["sign = 2", "[-1, 1]"]),
+        (linear_spec("ok.npz", anti_windup=1), ["anti_windup = 1", "expected true or false"]),
+        (
+            'type = "gain"\nsign = "minus"\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+            'sensors = ["tip_twist"]\nmatrix = [[1.0]]\n',
+            ["sign = 'minus'"],
+        ),
+        (
+            'type = "gain"\nsign = -1\nanti_windup = true\n[gain]\n'
+            'controls = ["aileron_hinge_moment"]\nsensors = ["tip_twist"]\nmatrix = [[1.0]]\n',
+            ["anti_windup = True", "a static gain has no state to wind up"],
+        ),
         (linear_spec("ok.npz", sign=0), ["sign"]),
         (linear_spec("ok.npz", function="f"), ["function", "not used by a controller of type"]),
         ('type = "linear"\n', ["file", "missing"]),
