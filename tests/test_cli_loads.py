@@ -402,6 +402,17 @@ def test_open_loop_scenario_with_mass_cases(tmp_path, capsys):
     b = recs["store"]["loads"]["root_torque"]["discrete"]
     assert not np.isclose(a, b, rtol=1e-3)
     assert re.search(r"store 1000 m V_C 90 m/s EAS", back.summary_text())
+    # issue 40: an open-loop result re-plots in every kind it has (its alleviation raises, and
+    # hasattr on it used to crash the command); the spanwise kind says what it needs
+    for kind in ("envelope", "correlated", "critical-gusts"):
+        png = tmp_path / f"re_{kind}.png"
+        assert main(["plot", str(out / "ol.json"), "--kind", kind, "--out", str(png)]) == 0
+        assert png.read_bytes()[:8] == PNG
+    capsys.readouterr()
+    png = tmp_path / "re_spanwise.png"
+    assert main(["plot", str(out / "ol.json"), "--kind", "spanwise", "--out", str(png)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "loads at two or more stations" in err and not png.exists()
 
 
 def test_failed_write_leaves_nothing(tmp_path, monkeypatch):

@@ -28,8 +28,9 @@ def add_parsers(sub) -> None:
         help=helptext,
         description="Discrete tuned gusts and continuous turbulence of CS-25.341 at every flight "
         "point of a gust_loads scenario, with and without its controller. Loads are increments "
-        "of the wing clamped at its root. Writes RESULT.json, .npz, .csv, _alleviation.csv and "
-        "the figures into --out (all or none); 'aeroservo plot DIR/RESULT.json' redraws them.",
+        "of the wing clamped at its root (1 g loads added with the airplane's mass). Writes "
+        "RESULT.json, .npz, .csv, _histories.csv, _alleviation.csv and the figures into --out "
+        "(all or none); 'aeroservo plot DIR/RESULT.json' redraws them.",
     )
     r.add_argument("scenario", help="scenario file (.toml, kind = 'gust_loads'), docs/scenarios.md")
     r.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")

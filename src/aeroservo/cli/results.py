@@ -269,7 +269,9 @@ def _gust_figures(res, src, args: argparse.Namespace, kind: str) -> int:
 
 def _what(res) -> tuple[str, tuple]:
     """What a loaded result is, and the figure kinds it has (default first)."""
-    if hasattr(res, "alleviation"):
+    from ..studies.gust_results import GustLoadsResult
+
+    if isinstance(res, GustLoadsResult):  # not hasattr: an open-loop result's alleviation raises
         return "gust loads", GUST_KINDS
     if hasattr(res, "hysteresis"):
         return "limit cycles", LCO_KINDS
