@@ -278,6 +278,11 @@ BAD = [
     ("stations = [1.2192, 2.4384, 3.6576, 4.8768]", "stations = []", "gust_loads.stations = []"),
     (
         "stations = [1.2192, 2.4384, 3.6576, 4.8768]",
+        "stations = [1.2192, 1.2202]",
+        "gust_loads.stations = [1.2192, 1.2202]: closer than 2 mm",
+    ),
+    (
+        "stations = [1.2192, 2.4384, 3.6576, 4.8768]",
         'stations = ["root"]',
         "gust_loads.stations[0] = 'root'",
     ),

@@ -287,3 +287,20 @@ def test_rigid_ratio_is_near_one_for_a_stiff_wing_and_above_for_goland():
         rel=1e-12,
     )
     assert rigid_gust_loads(aes.examples.goland_swept(), ["root_shear"], 1.2, 150.0, 10.0) == {}
+
+
+def test_station_names_round_to_the_millimetre():
+    """A station off the millimetre grid is found by its rounded name (0.5 mm at most), and two
+    stations that would share a name are refused."""
+    model = aes.AeroelasticModel(aes.examples.goland(), 10, load_stations=[1.2195, 3.0004])
+    names = [station_output("shear", 1.2195), station_output("torque", 3.0004)]
+    assert names == ["shear_at_1220mm", "torque_at_3000mm"]
+    sys = aes.statespace(model, 100.0, 1.225, inputs=["gust"], outputs=names)
+    assert list(sys.output_labels) == names
+    with pytest.raises(aes.InputError, match="closer than 2 mm"):
+        GustLoadsStudy(
+            mass_cases={"nominal": aes.examples.goland()},
+            points=(FlightPoint(0.0, 100.0, "V_C", "nominal"),),
+            loads=("root_shear",),
+            load_stations=(2.0, 2.0015),
+        )

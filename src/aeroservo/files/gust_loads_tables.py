@@ -90,6 +90,8 @@ def gust_loads_table(gl: Table, base: Path, wing) -> dict:
         ),
     )
     stations = gl.numbers("stations", [], unit="m", lo=0.0, hi=wing.span, increasing=True)
+    if any(b - a < 2e-3 for a, b in zip(stations[:-1], stations[1:], strict=True)):
+        gl.fail("stations", stations, "closer than 2 mm (loads are named to the millimetre)")
     out: dict = {
         "loads": tuple(gl.strings("loads", DEFAULT_LOADS)),
         "stations": tuple(stations),

@@ -326,7 +326,7 @@ def _station_node(model, spec: str, station: str) -> int:
         )
     nodes = model.mesh.nodes
     j = int(np.argmin(np.abs(nodes - x)))
-    if abs(nodes[j] - x) > max(5e-4, 1e-9 * span):
+    if abs(nodes[j] - x) > 5e-4 * (1 + 1e-6) + 1e-9 * span:  # the name's rounding to 1 mm
         near = ", ".join(f"{v:.6g}" for v in nodes[max(j - 1, 0) : j + 2])
         raise InputError(
             f"output {describe(spec)}: no mesh node at {x:g} m (nearest nodes {near} m); "

@@ -183,6 +183,13 @@ class GustLoadsStudy:
         from ..linear.signals import station_output
 
         stations = tuple(sorted({float(x) for x in self.load_stations}))
+        close = [(a, b) for a, b in zip(stations[:-1], stations[1:], strict=True) if b - a < 2e-3]
+        if close:
+            a, b = close[0]
+            raise InputError(
+                f"load_stations: {a:g} m and {b:g} m are closer than 2 mm (their loads are named "
+                "to the millimetre); keep one"
+            )
         object.__setattr__(self, "load_stations", stations)
         extra = [station_output(q, x) for x in stations for q in STATION_LOADS]
         object.__setattr__(self, "loads", tuple(dict.fromkeys(tuple(self.loads) + tuple(extra))))
