@@ -755,8 +755,8 @@ def test_continuous_compensator_is_discretised_by_the_method_of_its_file(setup, 
     discretised at the loop's rate by the file's ``method``: ``zoh`` gives the zero-order hold
     computed here, ``tustin`` (the default) the bilinear map, with ``prewarp`` exact at that
     frequency (frequency responses to 1e-9); ``sign = -1`` negates the output; MATLAB's
-    ``Ts = -1`` (unspecified) is discrete at the loop's period; ``anti_windup = false`` sets
-    the anti-windup gain to zero."""
+    ``Ts = -1`` (unspecified) is discrete at the loop's period; the anti-windup gain is zero
+    unless ``anti_windup = true`` (issue 38: the measured default of a compensator)."""
     _sc, _loop, _vf, hinf = setup
     mats = hinf.compensator_matrices()
     cont = inverse_tustin(mats)
@@ -776,6 +776,7 @@ def test_continuous_compensator_is_discretised_by_the_method_of_its_file(setup, 
         ("neg.npz", {"sign": -1}, H),
         ("c.mat", {"method": "tustin", "prewarp": 11.0}, _tustin_response(cont, FREQS, 11.0)),
         ("free.mat", {"anti_windup": False}, H),
+        ("free.mat", {"anti_windup": True}, H),
     ]
     for file, keys, expected in cases:
         spec = linear_spec(f"../../{file}", **keys)
@@ -784,7 +785,8 @@ def test_continuous_compensator_is_discretised_by_the_method_of_its_file(setup, 
         got = discrete_response(brought.compensator_matrices(), FREQS)
         assert np.max(np.abs(got - expected)) <= 1e-9 * np.max(np.abs(expected)), (file, keys)
         assert brought.dt == DT
-        assert bool(np.any(brought.anti_windup)) is ("anti_windup" not in keys), (file, keys)
+        # anti-windup: off unless the file asks (the measured default of a compensator)
+        assert bool(np.any(brought.anti_windup)) is keys.get("anti_windup", False), (file, keys)
         if "prewarp" in keys:  # exact at the prewarp frequency
             f0 = np.array([keys["prewarp"]])
             Hc = continuous_response(cont, f0)
