@@ -22,6 +22,7 @@ import scipy.linalg as sla
 from ..errors import RANGES, InputError, check_number
 from ..linear.models import check_continuous
 from ..linear.signals import check_names, check_signal_map, describe
+from ..linear.tags import carry_tags
 from .law import LinearLaw, state_gain
 
 MAX_CUTOFF = RANGES["frequency"].hi
@@ -362,10 +363,7 @@ def with_sensor_filters(sys, sensors: Sequence[str], cutoff: float, order: int =
         outputs=list(sys.output_labels),
         states=states,
     )
-    for attr in ("speed", "density", "signal_units"):
-        if hasattr(sys, attr):
-            setattr(out, attr, getattr(sys, attr))
-    return out
+    return carry_tags(sys, out)
 
 
 def filter_arrays(A, B, C, D, rows: Sequence[int], cutoff: float, order: int = 2) -> tuple:

@@ -18,6 +18,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import InputError, check_int
+from .tags import carry_tags
 
 __all__ = [
     "BalancedTruncation",
@@ -229,9 +230,7 @@ def balanced_truncation(
         inputs=list(ins),
         outputs=list(outs),
     )
-    for attr in ("speed", "density", "signal_units"):
-        if hasattr(sys, attr):
-            setattr(red, attr, getattr(sys, attr))
+    carry_tags(sys, red)
     err = np.abs(_frf(red, omega) - g).max(axis=2) / np.where(peak > 0, peak, 1.0)
     pairs = [(o, i) for o in outs for i in ins]
     idx = {(o, i): (a, b) for a, o in enumerate(outs) for b, i in enumerate(ins)}

@@ -60,7 +60,7 @@ SIDE_MARKERS = {("x", "max"): ">", ("x", "min"): "<", ("y", "max"): "^", ("y", "
 """Marker of each discrete extreme in the correlated-load plot."""
 
 
-def plot_envelope(result) -> Figure:
+def plot_envelope(result, loads=None) -> Figure:
     """Limit loads per flight point: one panel per load, open and closed loop side by side.
 
     The bar is the limit load (the larger of the discrete tuned-gust load ``max(|max|, |min|)``
@@ -74,13 +74,18 @@ def plot_envelope(result) -> Figure:
     Parameters
     ----------
     result : GustLoadsResult
+    loads : list of str, optional
+        Default: every load.
     """
     from matplotlib.colors import to_rgba
     from matplotlib.patches import Patch
 
     from .._figures import new_figure
 
-    points, loops, loads = point_indices(result), result.loops, result.loads
+    points, loops = point_indices(result), result.loops
+    loads = list(result.loads if loads is None else loads)
+    for n in loads:
+        check_load(result, n)
     raised: dict = {}
     if loops == ["open", "closed"]:
         a = result.alleviation

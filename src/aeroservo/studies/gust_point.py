@@ -11,6 +11,7 @@ import numpy as np
 
 from ..aero.gust_rules import GRADIENT_RANGE, design_gust_velocity, gust_tas
 from ..errors import InputError
+from ..linear.tags import carry_tags
 from .gust_loads import FlightPoint, GustLoadsStudy
 from .one_g import one_g_loads
 from .rigid_gust import rigid_gust_loads
@@ -120,10 +121,7 @@ def in_state_basis(plant, scaling: np.ndarray, reference: np.ndarray | None):
         outputs=list(plant.output_labels),
         states=list(plant.state_labels),
     )
-    for k in ("speed", "density", "signal_units"):
-        if hasattr(plant, k):
-            setattr(sys, k, getattr(plant, k))
-    return sys
+    return carry_tags(plant, sys)
 
 
 def with_control_outputs(sys, controls: list):
@@ -149,12 +147,7 @@ def with_control_outputs(sys, controls: list):
         outputs=list(sys.output_labels) + list(controls),
         states=list(sys.state_labels),
     )
-    for k in ("speed", "density"):
-        if hasattr(sys, k):
-            setattr(out, k, getattr(sys, k))
-    units = dict(getattr(sys, "signal_units", {}) or {})
-    out.signal_units = units
-    return out
+    return carry_tags(sys, out)  # the controls' units are the model's input units
 
 
 def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
