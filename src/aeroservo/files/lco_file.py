@@ -22,7 +22,7 @@ import numpy as np
 from ..atomic import atomic_write_set
 from ..errors import InputError
 from ..studies.lco_result import TABLE_COLUMNS, LCOResult
-from .summaries import json_text
+from .summaries import finite, json_text
 from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
 
 __all__ = ["FORMAT", "lco_items", "write_lco", "load_lco", "is_lco_file", "TABLE_UNITS"]
@@ -130,7 +130,8 @@ def lco_items(result: LCOResult, json_path: str | Path, summary: dict) -> dict:
     arrays = _arrays(result)
     npz = stem.parent / f"{stem.name}_histories.npz" if arrays else None
     items = {
-        "summary": (json_path, _text(lambda: json_text(_doc(result, summary, npz)))),
+        # standard JSON: a number that is not finite is null (the reader reads it as NaN)
+        "summary": (json_path, _text(lambda: json_text(finite(_doc(result, summary, npz))))),
         "table": (stem.with_suffix(".csv"), _text(lambda: table_csv(result))),
     }
     if result.branches is not None:

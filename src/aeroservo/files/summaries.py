@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-__all__ = ["json_text"]
+__all__ = ["json_text", "finite"]
 
 
 def _plain(o: object) -> object:
@@ -16,6 +16,20 @@ def _plain(o: object) -> object:
     if isinstance(o, np.ndarray):
         return o.tolist()
     return str(o)
+
+
+def finite(obj: object) -> object:
+    """``obj`` with every non-finite float (NaN, inf, also in numpy arrays and scalars) as
+    None, so that its JSON is standard (``null``, not ``NaN``)."""
+    if isinstance(obj, dict):
+        return {k: finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite(v) for v in obj]
+    if isinstance(obj, (np.ndarray, np.generic)):
+        return finite(obj.tolist())
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
 
 
 def json_text(obj: object, indent: int | None = 2) -> str:
