@@ -363,6 +363,8 @@ def _damaged(kind: str, doc: dict, npz: bytes) -> tuple[bytes, bytes | None]:
     }
     if kind in bad_rows:
         return json.dumps({**doc, "rows": [bad_rows[kind]] + doc["rows"][1:]}).encode(), None
+    if kind == "rows_empty":  # issue 40: the summary's min() of no speed was an internal error
+        return json.dumps({**doc, "rows": []}).encode(), None
     if kind == "settings_gap_text":
         return json.dumps({**doc, "settings": {**doc["settings"], "gap": "x"}}).encode(), None
     if kind == "settings_duration_text":
@@ -395,6 +397,7 @@ DAMAGED = {
     "row_kind_number": "rows[0].kind = 5: not what aeroservo writes",
     "row_start_unknown": "rows[0].start = 'sideways': not what aeroservo writes",
     "row_amplitude_text": "rows[0].amplitude = 'big': not what aeroservo writes",
+    "rows_empty": "'rows' is empty: a limit-cycle result has at least one march",
     "settings_gap_text": "settings.gap = 'x': expected a positive gap [rad] or null",
     "settings_duration_text": "settings.duration = 'long': not what aeroservo writes",
     "npz_corrupt": "r_histories.npz: not a .npz archive of limit-cycle histories",

@@ -208,6 +208,8 @@ def load_lco(path: str | Path) -> LCOResult:
         isinstance(r, dict) and all(k in r for k in TABLE_COLUMNS) for r in rows
     ):
         _fail(path, f"'rows' must be a list of marches with {list(TABLE_COLUMNS)}")
+    if not rows:  # a study marches at least one speed: an empty list is not what it writes
+        _fail(path, "'rows' is empty: a limit-cycle result has at least one march")
     if not isinstance(settings, dict):
         _fail(path, "'settings' must be a table")
     _check_settings(path, settings)
