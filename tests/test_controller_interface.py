@@ -1073,3 +1073,20 @@ def test_one_sign_rule_for_gain_and_linear_files(tmp_path):
             aes.InputError, match=r"brought\.toml: sign: .*give sign = 1 .* or sign = -1"
         ):
             load_scenario(path)
+
+
+def test_gain_bounds_and_unknown_states_name_the_file(tmp_path):
+    """Issue 40: a gain of 1e300 through the API is refused as the file type refuses it, and
+    a gain file on states the plant does not have names the file (it named nothing)."""
+    with pytest.raises(aes.InputError, match=r"K has an entry of 1e\+300 in magnitude: at most"):
+        static_gain([[1e300]], CONTROLS, sensors=["tip_twist"], sample_rate=RATE)
+    text = (
+        'type = "gain"\nname = "g"\nsign = -1\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
+        'states = ["w_3", "no_such_state"]\nmatrix = [[1.0, 2.0]]\n'
+    )
+    path = scenario_copy(tmp_path / "s", "goland_aileron_hinf", controller=text)
+    with pytest.raises(aes.InputError) as info:
+        _brought(path)
+    message = str(info.value)
+    assert "brought.toml" in message and "no_such_state" in message, message
+    assert "not states of the plant" in message and "\n" not in message

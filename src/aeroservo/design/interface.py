@@ -167,6 +167,10 @@ class StateGain:
         pass
 
 
+MAX_GAIN = 1e12
+"""Largest magnitude of a static gain's entry [signal units], as a gain file's ``matrix``."""
+
+
 def static_gain(
     K,
     controls: Sequence[str],
@@ -214,6 +218,11 @@ def static_gain(
         )
     if not np.all(np.isfinite(G)):
         raise InputError("K has NaN or infinite entries")
+    if np.abs(G).max(initial=0.0) > MAX_GAIN:
+        raise InputError(
+            f"K has an entry of {np.abs(G).max():.3g} in magnitude: at most {MAX_GAIN:g} (signal "
+            "units; a controller file's gain matrix has the same bound)"
+        )
     dt = sample_period(sample_rate)
     if states is not None:
         return StateGain(-sign * G, controls, cols, dt)  # a StateGain is u = -K x

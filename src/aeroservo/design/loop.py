@@ -224,7 +224,12 @@ class ControlLoop:
             return OpenLoop(tuple(self.controls), 1.0 / rate)
         if spec.type in ("linear", "gain", "python"):
             try:
-                return brought_controller(spec, self.controls, self.sensors, rate)
+                ctrl = brought_controller(spec, self.controls, self.sensors, rate)
+                if spec.type == "gain" and (spec.gain or {}).get("states"):
+                    from .sampled_loop import plant_states
+
+                    ctrl.law(plant_states(self.plant(speed)))  # its states must be the plant's
+                return ctrl
             except InputError as exc:
                 raise InputError(f"{spec.source}: {exc}") from None
         if spec.type == "hinf":

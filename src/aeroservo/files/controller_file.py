@@ -16,6 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..design.hinf import HinfWeights
+from ..design.interface import MAX_GAIN
 from ..design.margin_requirement import BREAK_POINT_KEYS, MarginRequirement
 from ..design.mpc import SOLVERS
 from ..design.plant import Limits
@@ -216,7 +217,7 @@ def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
                 g.fail("matrix", rows, f"row {i}: expected {len(cols)} numbers")
             K.append(
                 [
-                    g.check_value(f"matrix[{i}][{j}]", x, lo=-1e12, hi=1e12)
+                    g.check_value(f"matrix[{i}][{j}]", x, lo=-MAX_GAIN, hi=MAX_GAIN)
                     for j, x in enumerate(row)
                 ]
             )
