@@ -255,7 +255,7 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
             quantity, station = m.groups()
             node = _station_node(model, spec, station)
             unit = "N" if quantity == "shear" else "N m"
-            idx = ("shear", "bending_moment", "torque").index(quantity)
+            idx = STATION_QUANTITIES.index(quantity)
             out.append(OutputDef(spec, "cut", unit, index=idx, node=node))
             continue
         m = _MODAL.match(spec)
@@ -308,6 +308,21 @@ def resolve_outputs(model, specs, n_modes_available: int) -> list[OutputDef]:
 
 
 _CUT = re.compile(r"^(shear|bending_moment|torque)_at_(.*)mm$")
+
+
+def station_of(name: str) -> tuple[str, float] | None:
+    """``(quantity, station [m])`` of a root or station load name (``root_shear`` is at 0,
+    ``torque_at_2500mm`` at 2.5 m), or None for any other output."""
+    if name.startswith("root_") and name[5:] in STATION_QUANTITIES:
+        return name[5:], 0.0
+    m = _CUT.match(name)
+    if m is None or not m.group(2).isdigit():
+        return None
+    return m.group(1), int(m.group(2)) / 1000.0
+
+
+STATION_QUANTITIES = ("shear", "bending_moment", "torque")
+"""The internal loads of a section, in the order of its reaction rows."""
 
 
 def station_output(quantity: str, station: float) -> str:

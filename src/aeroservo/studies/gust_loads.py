@@ -26,12 +26,9 @@ from ..aero.gust_rules import flight_profile_alleviation
 from ..errors import InputError, check_int, check_number
 from ..system.damping import NO_DAMPING, StructuralDamping
 
-__all__ = ["FlightPoint", "GustLoadsStudy", "SPEED_NAMES", "STATION_LOADS"]
+__all__ = ["FlightPoint", "GustLoadsStudy", "SPEED_NAMES"]
 
 SPEED_NAMES = ("V_C", "V_D", "")
-
-STATION_LOADS = ("shear", "bending_moment", "torque")
-"""The loads of each load station."""
 
 
 @dataclass(frozen=True)
@@ -180,7 +177,7 @@ class GustLoadsStudy:
                     f"flight point {p.label}: mass_case = {p.mass_case!r} is not one of "
                     f"{list(self.mass_cases)}"
                 )
-        from ..linear.signals import station_output
+        from ..linear.signals import STATION_QUANTITIES, station_output
 
         stations = tuple(sorted({float(x) for x in self.load_stations}))
         close = [(a, b) for a, b in zip(stations[:-1], stations[1:], strict=True) if b - a < 2e-3]
@@ -191,7 +188,7 @@ class GustLoadsStudy:
                 "to the millimetre); keep one"
             )
         object.__setattr__(self, "load_stations", stations)
-        extra = [station_output(q, x) for x in stations for q in STATION_LOADS]
+        extra = [station_output(q, x) for x in stations for q in STATION_QUANTITIES]
         object.__setattr__(self, "loads", tuple(dict.fromkeys(tuple(self.loads) + tuple(extra))))
         if not self.loads:
             raise InputError("gust loads: name at least one load (an output of the model)")

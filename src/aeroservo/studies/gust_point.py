@@ -228,8 +228,9 @@ def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
             try:
                 tsys, outs = sys, list(study.loads)
                 if spec is not None:  # the commands applied are loads too (A-bar of each)
-                    tsys = with_control_outputs(sys, [c for c in spec[0].controls if c not in outs])
-                    outs = list(dict.fromkeys(outs + list(spec[0].controls)))
+                    extra = [c for c in ctrl.controls if c not in sys.output_labels]
+                    tsys = with_control_outputs(sys, extra)
+                    outs = list(dict.fromkeys(outs + list(ctrl.controls)))
                 res.turbulence[name] = turbulence_response(tsys, outs, **kw)
             except InputError as exc:
                 res.notes.append(f"{name} loop turbulence: {exc}")

@@ -9,12 +9,12 @@ same worst point as a thin black line (:mod:`~aeroservo.studies.rigid_gust`).
 
 from __future__ import annotations
 
-import re
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
+from ..linear.signals import STATION_QUANTITIES, station_of
 from .gust_plot_parts import INCREMENTAL, LOOP_COLORS, display_unit, footer, point_notes
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -22,20 +22,15 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["plot_spanwise", "span_loads"]
 
-QUANTITIES = ("shear", "bending_moment", "torque")
-_STATION = re.compile(r"^(shear|bending_moment|torque)_at_(\d+)mm$")
-
 
 def span_loads(result) -> dict[str, list[tuple[float, str]]]:
     """``{quantity: [(station [m], load name), ...]}`` of the root and station loads of a
     result, by increasing station (a quantity with fewer than two stations is left out)."""
-    out: dict[str, list[tuple[float, str]]] = {q: [] for q in QUANTITIES}
+    out: dict[str, list[tuple[float, str]]] = {q: [] for q in STATION_QUANTITIES}
     for name in result.loads:
-        if name.startswith("root_") and name[5:] in QUANTITIES:
-            out[name[5:]].append((0.0, name))
-        m = _STATION.match(name)
-        if m:
-            out[m.group(1)].append((int(m.group(2)) / 1000.0, name))
+        which = station_of(name)
+        if which is not None:
+            out[which[0]].append((which[1], name))
     return {q: sorted(v) for q, v in out.items() if len({x for x, _ in v}) >= 2}
 
 

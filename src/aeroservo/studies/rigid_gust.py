@@ -20,21 +20,12 @@ wings and the shear, bending moment and torque at the root and at load stations.
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
 
+from ..linear.signals import station_of
+
 __all__ = ["rigid_gust_loads"]
-
-_STATION = re.compile(r"^(shear|bending_moment|torque)_at_(\d+)mm$")
-_ROOT = {"root_shear": "shear", "root_bending_moment": "bending_moment", "root_torque": "torque"}
-
-
-def _station_of(name: str) -> tuple[str, float] | None:
-    if name in _ROOT:
-        return _ROOT[name], 0.0
-    m = _STATION.match(name)
-    return (m.group(1), int(m.group(2)) / 1000.0) if m else None
 
 
 def rigid_gust_loads(wing, loads, density: float, speed: float, gust: float) -> dict:
@@ -64,7 +55,7 @@ def rigid_gust_loads(wing, loads, density: float, speed: float, gust: float) -> 
     out = {}
     q = 2 * math.pi * density * speed * gust  # lift per unit span per metre of semichord
     for name in loads:
-        which = _station_of(name)
+        which = station_of(name)
         if which is None:
             continue
         kind, x = which
