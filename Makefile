@@ -21,8 +21,8 @@ demo: install
 	mkdir -p out
 	$(BIN)/aeroservo flutter goland --pk --plot out/goland_vg.png
 	$(BIN)/aeroservo flutter scenarios/goland_aileron.toml --json > out/goland_aileron_flutter.json
-	$(BIN)/aeroservo simulate scenarios/goland_aileron_lqr.toml --out out
-	@echo "wrote out/goland_vg.png, out/goland_aileron_flutter.json and out/goland_aileron_lqr.*"
+	$(BIN)/aeroservo simulate scenarios/goland_aileron_lqg.toml --out out
+	@echo "wrote out/goland_vg.png, out/goland_aileron_flutter.json and out/goland_aileron_lqg.*"
 
 lint: install
 	$(BIN)/ruff check src tests bench

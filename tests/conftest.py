@@ -40,11 +40,13 @@ def needs_panelaero():
 
 def designed_loop(stem: str):
     """A shipped scenario's plant and designed controller at its design speed (a schedule
-    evaluated there): ``(plant, controller)``."""
+    evaluated there), with an ideal actuator (``ideal_loops``): ``(plant, controller)``."""
+    from ideal_loops import ideal
+
     from aeroservo.files import load_scenario
     from aeroservo.stability.boundary import flutter_boundary
 
-    sc = load_scenario(ROOT / "scenarios" / f"{stem}.toml")
+    sc = ideal(load_scenario(ROOT / "scenarios" / f"{stem}.toml"))  # the loops they check
     model = sc.model()
     vf = flutter_boundary(model, sc.density).flutter_speed
     loop = sc.loop(model)

@@ -31,6 +31,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.optimize as so
 from conftest import ROOT
+from ideal_loops import ideal
 
 import aeroservo as aes
 from aeroservo.design.compensator import compensator_from_lti
@@ -238,7 +239,7 @@ def check_actuator_margins(ol, ch, dt=DT):
 def shipped(kind: str):
     """``(loop, plant, controller as designed, spec, vf, speed)`` of a shipped scenario at
     1.1 x its open-loop flutter speed (a schedule is returned as it is)."""
-    sc = load_scenario(ROOT / "scenarios" / f"goland_aileron_{kind}.toml")
+    sc = ideal(load_scenario(ROOT / "scenarios" / f"goland_aileron_{kind}.toml"))
     model = sc.model()
     vf = flutter_boundary(model, sc.density).flutter_speed
     loop = sc.loop(model)

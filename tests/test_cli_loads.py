@@ -84,8 +84,8 @@ def test_loads_command_writes_the_set(cli_run):
     for f in FIGURES:
         assert (out / f"{STEM}_{f}.png").read_bytes()[:8] == PNG
     assert "open loop, worst limit load" in text and "closed loop, worst limit load" in text
-    # issue 38: the example's LQR is a state feedback; the report says what it measures
-    assert "the closed loop feeds back the plant state (state feedback): not realisable" in text
+    # issue 38: the example's loop is an LQG on the tip sensors; the report says what it measures
+    assert "the closed loop feeds back its sensors: tip_le_accel, tip_te_accel, tip_twist" in text
     doc = json.loads((out / f"{STEM}.json").read_text())
     assert sorted(Path(p).name for p in doc["files"].values()) == sorted(expected)
     for name in expected:
@@ -249,19 +249,19 @@ BAD = [
         "flight: missing required table (the controller's design point",
     ),
     (
-        'spec = "../controllers/lqr.toml"',
+        'spec = "../controllers/lqg.toml"',
         'design_mass_case = "nominal"',
         "controller.design_mass_case = 'nominal': needs controller.spec",
     ),
     (
-        'spec = "../controllers/lqr.toml"',
-        'spec = "../controllers/lqr.toml"\ndesign_mass_case = "x"',
+        'spec = "../controllers/lqg.toml"',
+        'spec = "../controllers/lqg.toml"\ndesign_mass_case = "x"',
         "controller.design_mass_case = 'x': not a mass case; they are ['nominal']",
     ),
     ("[output]", "[disturbance]\ninitial_tip = 0.01\n[output]", "disturbance = {"),
     (
-        'spec = "../controllers/lqr.toml"',
-        'spec = "../controllers/lqr.toml"\nengaged_speeds = [50.0, 150.0]',
+        'spec = "../controllers/lqg.toml"',
+        'spec = "../controllers/lqg.toml"\nengaged_speeds = [50.0, 150.0]',
         "controller.engaged_speeds = [50.0, 150.0]: unknown key",
     ),
     # issue 38: load stations, V_C / V_D, the 1 g trim
@@ -311,7 +311,7 @@ def _absolute(text: str) -> str:
     """A scenario's text with the shipped files it names as absolute paths."""
     for name in ("goland_aileron.toml", "goland.toml"):
         text = text.replace(f'"{name}"', f'"{ROOT / "scenarios" / name}"')
-    return text.replace('"../controllers/lqr.toml"', f'"{ROOT / "controllers" / "lqr.toml"}"')
+    return text.replace('"../controllers/lqg.toml"', f'"{ROOT / "controllers" / "lqg.toml"}"')
 
 
 @pytest.mark.parametrize("old,new,message", BAD, ids=[m[:40] for _o, _n, m in BAD])

@@ -19,6 +19,7 @@ import pytest
 import scipy.io
 import scipy.linalg as sla
 from conftest import ROOT
+from ideal_loops import ideal, ideal_hinf_text, ideal_text
 
 import aeroservo as aes
 from aeroservo import cli
@@ -52,7 +53,7 @@ VF = 137.37  # open-loop flutter speed [m/s], checked by the fixture
 def setup():
     """The shipped H-infinity scenario's loop, the open-loop flutter speed and the shipped
     H-infinity compensator designed at 1.1 V_f (as the scenario designs it)."""
-    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml")
+    sc = ideal(load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml"))
     model = sc.model()
     loop = sc.loop(model)
     vf = aes.flutter_boundary(model, RHO).flutter_speed
@@ -282,11 +283,14 @@ def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
 def scenario_copy(tmp_path, scenario: str, *edits, controller: str | None = None):
     """A shipped scenario (and every shipped controller) copied to ``tmp_path`` and edited:
     ``(old, new)`` text replacements in the scenario file; ``controller`` replaces the text of
-    the controller file it refers to by a new file ``controllers/brought.toml``."""
+    the controller file it refers to by a new file ``controllers/brought.toml``. The copies are
+    the ideal-actuator loops without delay (``ideal_loops``)."""
     shutil.copytree(ROOT / "scenarios", tmp_path / "scenarios", dirs_exist_ok=True)
     shutil.copytree(ROOT / "controllers", tmp_path / "controllers", dirs_exist_ok=True)
+    hinf = tmp_path / "controllers" / "hinf.toml"  # the loops these tests were written for
+    hinf.write_text(ideal_hinf_text(hinf.read_text()))
     path = tmp_path / "scenarios" / f"{scenario}.toml"
-    text = path.read_text()
+    text = ideal_text(path.read_text())
     if controller is not None:
         (tmp_path / "controllers" / "brought.toml").write_text(controller)
         old = next(line for line in text.splitlines() if line.startswith("spec = "))
@@ -689,7 +693,9 @@ def assert_same_numbers(a, b, rel: float, path: str = "") -> None:
 @pytest.fixture(scope="module")
 def builtin_hinf_run():
     """The shipped H-infinity scenario, quick settings."""
-    return run_simulation(quick(load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml")))
+    return run_simulation(
+        ideal(quick(load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml")))
+    )
 
 
 def _brought(path):

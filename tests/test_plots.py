@@ -24,6 +24,7 @@ def test_margin_figures(tmp_path):
     """Nyquist/Bode and margin-sweep figures of the shipped LQR loop: labelled axes with units,
     the margins' frequencies marked, the requirement drawn, files written."""
     from conftest import ROOT
+    from ideal_loops import ideal
 
     from aeroservo.design.margin_sweep import margins_over_speed
     from aeroservo.design.margins import loop_margins
@@ -31,7 +32,7 @@ def test_margin_figures(tmp_path):
     from aeroservo.plots import plot_loop_margins, plot_margin_sweep
     from aeroservo.stability.boundary import flutter_boundary
 
-    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
+    sc = ideal(load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml"))
     model = sc.model()
     vf = flutter_boundary(model, sc.density).flutter_speed
     loop = sc.loop(model)

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 from conftest import ROOT
+from ideal_loops import ideal
 
 import aeroservo as aes
 from aeroservo.design.anti_windup import has_anti_windup, with_anti_windup
@@ -29,7 +30,7 @@ HM = "aileron_hinge_moment"
 
 @functools.cache
 def hinf_loop():
-    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml")
+    sc = ideal(load_scenario(ROOT / "scenarios" / "goland_aileron_hinf.toml"))
     model = sc.model()
     vf = flutter_boundary(model, sc.density).flutter_speed
     loop = sc.loop(model)

@@ -84,6 +84,8 @@ def test_scenario_delay_reaches_the_boundary(tmp_path):
     from aeroservo.studies.runs import run_simulation
 
     sc = quick(load_scenario(ROOT / "scenarios" / "goland_aileron_lqg.toml"))
+    assert sc.delay is True  # the default (issue 38)
+    sc = dataclasses.replace(sc, delay=False)
     plain = run_simulation(sc).summary["closed_loop"]
     delayed = run_simulation(dataclasses.replace(sc, delay=True)).summary["closed_loop"]
     assert delayed["delay"] is True and plain["delay"] is False

@@ -10,6 +10,7 @@ import shutil
 import numpy as np
 import pytest
 from conftest import ROOT, designed_loop
+from ideal_loops import ideal, ideal_text
 
 from aeroservo import cli
 from aeroservo.files import load_result, load_scenario
@@ -27,10 +28,12 @@ EIGHT_MODES = ("design_modes = 20", "design_modes = 8 ")
 
 def variant(tmp_path, scenario: str, controller: str, *edits) -> object:
     """A shipped scenario and its controller file copied to ``tmp_path`` and edited
-    (``(old, new)`` text replacements, each must apply to one of the two files)."""
+    (``(old, new)`` text replacements, each must apply to one of the two files); the scenario
+    with an ideal actuator and no delay (``ideal_loops``)."""
     shutil.copytree(ROOT / "scenarios", tmp_path / "scenarios")
     shutil.copytree(ROOT / "controllers", tmp_path / "controllers")
     files = [tmp_path / "scenarios" / f"{scenario}.toml", tmp_path / "controllers" / controller]
+    files[0].write_text(ideal_text(files[0].read_text()))  # the loops these tests were made for
     for old, new in edits:
         hits = [f for f in files if old in f.read_text()]
         assert hits, old
@@ -103,7 +106,7 @@ def test_expected_instability_exits_0(capsys, tmp_path):
 def test_rate_limited_first_command_is_reported():
     """The first LQR command (-219 N m after a 1 cm tip deflection) is rate-limited to the
     200 N m a sample allows: ``rate_limited_fraction`` says so (saturation stays 0)."""
-    sc = quick(load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml"))
+    sc = ideal(quick(load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")))
     run = run_simulation(sc)
     sim, s = run.simulation, run.summary
     c0 = sim.commands["aileron_hinge_moment"][0]

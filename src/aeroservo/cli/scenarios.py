@@ -168,12 +168,19 @@ def _margin_lines(m: dict | None) -> list[str]:
     outs = m.get("multiloop_outputs") or {}
     if len(m.get("sensors", {})) > 1 and outs.get("disk_margin") is not None:
         judged = "judged" if "multiloop" in at else "reported"
+        gm, pm, f = (outs.get(k) for k in ("disk_gain_margin_db", "disk_phase_margin_deg",
+                                           "frequency"))  # fmt: skip
         out.append(
             f"    all sensors at once ({judged}): disk {outs['disk_margin']:.3g} "
-            f"(+-{outs['disk_gain_margin_db']:.3g} dB, +-{outs['disk_phase_margin_deg']:.3g} deg "
-            f"at {outs['frequency']:.3g} Hz; {outs['method']})"
+            f"(+-{_unbounded(gm)} dB, +-{_unbounded(pm)} deg at {_unbounded(f)} Hz; "
+            f"{outs['method']})"
         )
     return out
+
+
+def _unbounded(x) -> str:
+    """A margin figure, or "inf" where the JSON holds null for an unbounded one."""
+    return "inf" if x is None else f"{x:.3g}"
 
 
 def _engaged_lines(s: dict) -> list[str]:
@@ -235,10 +242,11 @@ def _readable(s: dict) -> str:
             f"  {s['controller']} at {s['speed']:.5g} m/s "
             f"(open-loop flutter {f(s['open_loop_flutter_speed'], ' m/s')})"
         )
+        width = max([24] + [len(n) for n in s["signals"]])
         for name, v in s["signals"].items():
             unit = s["units"].get(name, "")
             lines.append(
-                f"  {name:24s} peak {v['peak']:10.4g} {unit:6s} rms {v['rms']:10.4g}  "
+                f"  {name:{width}s} peak {v['peak']:10.4g} {unit:6s} rms {v['rms']:10.4g}  "
                 f"growth {v['growth']:.3g}"
             )
         if "verdict" in s:

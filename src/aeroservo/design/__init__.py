@@ -10,6 +10,7 @@ design models of one wing and turns a :class:`ControllerSpec` (a controller file
 controller at a design speed.
 """
 
+from .actuator import ActuatorDynamics
 from .boundary_result import ClosedLoopBoundary
 from .closed_loop import closed_loop_boundary, closed_loop_matrix
 from .compensator import DiscreteCompensator, compensator_from_lti
@@ -28,6 +29,7 @@ from .schedule import GainSchedule, schedule
 from .spec import ControllerSpec
 
 __all__ = [
+    "ActuatorDynamics",
     "loop_hinge_plant",
     "Bryson",
     "ClosedLoopBoundary",

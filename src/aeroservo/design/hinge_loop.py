@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ..errors import InputError
 from ..linear.hinge_plant import NonlinearPlant, hinge_inputs, hinge_rates, split_plant
 from ..linear.state_space import StateSpaceBuilder
 from ..system.hinge_elements import NonlinearHinge, hinge_elements
@@ -20,8 +21,15 @@ def loop_hinge_plant(loop, hinges: Sequence[NonlinearHinge], speed: float) -> No
     """The nonlinear plant of ``loop`` (a :class:`~aeroservo.design.loop.ControlLoop`) at
     ``speed`` [m/s] with the nonlinear ``hinges``.
 
-    Its outputs are the loop's outputs and each element's ``<actuator>_rotation`` [rad].
+    Its outputs are the loop's outputs and each element's ``<actuator>_rotation`` [rad]. A loop
+    with actuator dynamics is refused (the hinge march does not model them yet).
     """
+    if getattr(loop, "actuators", None):
+        raise InputError(
+            f"loop_hinge_plant: the loop has actuator dynamics on {list(loop.actuators)}; the "
+            "march with nonlinear hinges does not model them yet: build the loop without "
+            "actuator= (an ideal actuator)"
+        )
     elements = hinge_elements(loop.model, hinges)
     base = loop.plant_builder
     inputs = list(base.input_labels)

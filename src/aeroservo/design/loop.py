@@ -23,6 +23,8 @@ import numpy as np
 from ..errors import InputError, check_int, check_number
 from ..linear.models import tip_deflection_state
 from ..linear.state_space import StateSpaceBuilder
+from ..linear.tags import carry_tags
+from .actuator import actuator_arrays, actuator_labels, actuators_of
 from .compensator import compensator_from_lti
 from .hinf import hinf
 from .interface import python_law, static_gain
@@ -31,7 +33,7 @@ from .lqr import Bryson, lqr
 from .mpc import mpc
 from .plant import OpenLoop, SampledPlant, filter_arrays, state_map, with_sensor_filters
 from .schedule import GainSchedule, schedule
-from .spec import ControllerSpec
+from .spec import ControllerSpec, check_spec_signals
 
 SAMPLED_CACHE = 96
 """Sampled plants kept per :class:`ControlLoop` (about 80 kB each for a 10-element wing)."""
@@ -61,6 +63,10 @@ class ControlLoop:
         Order of those filters.
     gust : str
         Gust model of the plant (``"kussner"`` or ``"upwash"``).
+    actuator : ActuatorDynamics or dict of ActuatorDynamics, optional
+        Actuator dynamics in series with the controls (one for all, or by control name; None:
+        ideal), in the plant and in the design models of LQG, H-infinity and MPC
+        (:mod:`aeroservo.design.actuator`); the loop's limits then bound its output.
     """
 
     def __init__(
@@ -75,6 +81,7 @@ class ControlLoop:
         sensor_filter: float | None = 30.0,
         filter_order: int = 2,
         gust: str = "kussner",
+        actuator=None,
     ):
         self.model = model
         self.density = check_number("density", density, unit="kg/m^3", lo=0.0, lo_open=True)
@@ -102,17 +109,48 @@ class ControlLoop:
         self.sensor_filter = sensor_filter if self.filtered else None
         self.filter_order = filter_order
         self.T = state_map(self.plant_builder, self.design_builder)
+        self.actuators = actuators_of(actuator, self.controls)
+        inputs = self.plant_builder.input_labels
+        self._act_columns = [inputs.index(c) for c in self.actuators]
         self._sampled: OrderedDict = OrderedDict()
 
     @property
     def units(self) -> dict:
         """Signal units by name."""
-        return dict(self.plant_builder.units)
+        return {**self.plant_builder.units, **self._actuator_units}
 
     def _filter(self, sys):
-        if self.sensor_filter is None:
+        """``sys`` with the sensor filters, then the actuators."""
+        if self.sensor_filter is not None:
+            sys = with_sensor_filters(sys, self.filtered, self.sensor_filter, self.filter_order)
+        return self._actuate(sys)
+
+    def _actuate(self, sys):
+        """``sys`` with the actuators in series with its controls (states last)."""
+        if not self.actuators:
             return sys
-        return with_sensor_filters(sys, self.filtered, self.sensor_filter, self.filter_order)
+        import control
+
+        arrays = actuator_arrays(*(np.asarray(x) for x in control.ssdata(sys)),
+                                 self._act_columns, list(self.actuators.values()))  # fmt: skip
+        extra = [c + s for c in self.actuators for s in ("_actuator", "_actuator_rate")]
+        out = control.ss(*arrays, inputs=list(sys.input_labels),
+                         outputs=list(sys.output_labels) + extra,
+                         states=list(sys.state_labels) + self._actuator_states)  # fmt: skip
+        carry_tags(sys, out)
+        out.signal_units = {**getattr(sys, "signal_units", {}), **self._actuator_units}
+        return out
+
+    @property
+    def _actuator_units(self) -> dict:
+        u = self.plant_builder.units
+        return {k: v for c in self.actuators
+                for k, v in ((f"{c}_actuator", u[c]),
+                             (f"{c}_actuator_rate", f"{u[c]}/s"))}  # fmt: skip
+
+    @property
+    def _actuator_states(self) -> list[str]:
+        return [n for c, a in self.actuators.items() for n in actuator_labels(c, a)]
 
     def plant(self, speed: float):
         """Full plant at ``speed`` [m/s] (``control.StateSpace``, filters included)."""
@@ -139,7 +177,12 @@ class ControlLoop:
         if self.sensor_filter is not None:
             rows = [self.plant_builder.output_labels.index(s) for s in self.filtered]
             arrays = filter_arrays(*arrays, rows, self.sensor_filter, self.filter_order)
-        labels = (self.plant_builder.input_labels, self.plant_builder.output_labels)
+        outs = tuple(self.plant_builder.output_labels)
+        if self.actuators:
+            acts = list(self.actuators.values())
+            arrays = actuator_arrays(*arrays, self._act_columns, acts)
+            outs += tuple(c + s for c in self.actuators for s in ("_actuator", "_actuator_rate"))
+        labels = (self.plant_builder.input_labels, outs)
         sp = SampledPlant.from_arrays(arrays, labels, dt, controls, (), outputs)
         self._sampled[key] = sp
         while len(self._sampled) > SAMPLED_CACHE:
@@ -147,36 +190,43 @@ class ControlLoop:
         return sp
 
     def design(self, speed: float, filtered: bool = True):
-        """Design model at ``speed`` [m/s] (truncated; filters included if ``filtered``)."""
+        """Design model at ``speed`` [m/s] (truncated, with the actuators; the sensor filters
+        too if ``filtered``)."""
         d = self.design_builder.at(speed)
-        return self._filter(d) if filtered else d
+        return self._filter(d) if filtered else self._actuate(d)
 
     @property
     def n_plant_states(self) -> int:
-        """States of the full plant, sensor filters included."""
-        return self.plant_builder.n_states + self.n_filter_states
+        """States of the full plant, sensor filters and actuators included."""
+        return self.plant_builder.n_states + self.n_filter_states + len(self._actuator_states)
 
     @property
     def state_labels(self) -> tuple[str, ...]:
-        """Names of the full plant's states, filter states (``<sensor>_filter<i>``) last."""
+        """Names of the full plant's states, then filter states (``<sensor>_filter<i>``),
+        then actuator states (``<control>_actuator...``)."""
         names = tuple(self.plant_builder.state_labels)
-        if self.sensor_filter is None:
-            return names
-        k = self.filter_order
-        return names + tuple(f"{s}_filter{i + 1}" for s in self.filtered for i in range(k))
+        if self.sensor_filter is not None:
+            k = self.filter_order
+            names += tuple(f"{s}_filter{i + 1}" for s in self.filtered for i in range(k))
+        return names + tuple(self._actuator_states)
 
     @property
     def n_filter_states(self) -> int:
         return self.filter_order * len(self.filtered) if self.sensor_filter is not None else 0
 
     def plant_state_map(self) -> np.ndarray:
-        """``x_design = T x_plant`` for the unfiltered design model (filter states ignored)."""
-        return np.hstack([self.T, np.zeros((self.T.shape[0], self.n_filter_states))])
+        """``x_design = T x_plant`` for the design model without sensor filters (filter
+        states ignored; actuator states, last in both, shared)."""
+        n_a = len(self._actuator_states)
+        T = np.zeros((self.T.shape[0] + n_a, self.n_plant_states))
+        T[: self.T.shape[0], : self.T.shape[1]] = self.T
+        T[self.T.shape[0] :, self.n_plant_states - n_a :] = np.eye(n_a)
+        return T
 
     def initial_state(self, tip: float) -> np.ndarray:
         """Plant state with the static tip-load shape scaled to a tip deflection ``tip`` [m]."""
         x = tip_deflection_state(self.plant_builder, tip)
-        return np.r_[x, np.zeros(self.n_filter_states)]
+        return np.r_[x, np.zeros(self.n_plant_states - len(x))]
 
     def bryson(self, spec: ControllerSpec) -> Bryson:
         return Bryson(spec.bryson_outputs, spec.bryson_inputs, spec.state_weight)
@@ -330,55 +380,3 @@ def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
         needs_state=p.get("needs_state", False),
         name=p.get("source", "Python law"),
     )
-
-
-def check_spec_signals(
-    spec: ControllerSpec, controls: Sequence[str], sensors: Sequence[str], outputs: Sequence[str]
-) -> None:
-    """Check a controller spec's signal names against a loop's controls, sensors and outputs.
-
-    Raises
-    ------
-    InputError
-        Naming the spec's file, the key and the signal.
-    """
-    outputs = list(dict.fromkeys(list(sensors) + list(outputs)))
-    allowed = {
-        "weights.outputs": outputs,
-        "weights.inputs": list(controls),
-        "weights.sensors": list(sensors),
-        "limits.magnitude": list(controls),
-        "limits.rate": list(controls),
-        "estimator.process_noise": ["gust"],
-        "estimator.sensor_noise": list(sensors),
-        "estimator.input_noise": list(controls),
-        "mpc.soft_outputs": outputs,
-        "linear inputs": outputs,
-        "linear outputs": list(controls),
-        "gain.controls": list(controls),
-        "gain.sensors": outputs,
-        "python.sensors": outputs,
-    }
-    for key, names in spec.signals.items():
-        for n in names:
-            if n not in allowed[key]:
-                raise InputError(
-                    f"{spec.source}: {key}.{n}: not a signal of this loop; allowed {allowed[key]}"
-                )
-    if spec.type in ("lqr", "lqg", "mpc", "hinf"):
-        missing = [c for c in controls if c not in spec.bryson_inputs]
-        if missing:
-            raise InputError(f"{spec.source}: weights.inputs: give an allowed value for {missing}")
-    if spec.type == "hinf":
-        missing = [s for s in sensors if s not in spec.sensor_scales]
-        if missing:
-            raise InputError(
-                f"{spec.source}: weights.sensors: give a nominal magnitude for {missing}"
-            )
-
-    if spec.type in ("lqg", "mpc"):
-        missing = [s for s in sensors if s not in spec.sensor_noise]
-        if missing:
-            raise InputError(
-                f"{spec.source}: estimator.sensor_noise: give a variance for {missing}"
-            )

@@ -26,6 +26,7 @@ STATE_KINDS = (
     (re.compile(r"^z\d+_"), "aerodynamic lag states"),
     (re.compile(r"^g\d+_"), "gust states"),
     (re.compile(r"_filter\d+$"), "sensor-filter states"),
+    (re.compile(r"_actuator(_rate|_lag)?$"), "actuator states"),
     (re.compile(r"_dot$"), "structural velocities"),
 )
 """Plant state names (``aeroservo.linear.tags``) by kind; the rest are structural

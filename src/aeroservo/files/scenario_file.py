@@ -24,6 +24,7 @@ from .gust_loads_tables import gust_cross_check, gust_loads_tables
 from .lco_tables import lco_cross_check, lco_tables, section_table
 from .scenario_checks import cross_check
 from .scenario_tables import (
+    actuator_table,
     controller,
     disturbance,
     engaged_speeds,
@@ -43,6 +44,7 @@ TOP = (
     "flight",
     "model",
     "signals",
+    "actuator",
     "disturbance",
     "controller",
     "simulation",
@@ -64,6 +66,7 @@ USED = {
         "flight",
         "model",
         "signals",
+        "actuator",
         "simulation",
         "output",
         "damping",
@@ -75,6 +78,7 @@ USED = {
         "flight",
         "model",
         "signals",
+        "actuator",
         "controller",
         "simulation",
         "output",
@@ -250,6 +254,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         sg.fail("sensor_filter", cutoff, f"0 (no filter) or at least {MIN_FILTER:g} Hz")
     kw["sensor_filter"] = None if cutoff == 0 else cutoff
     kw["filter_order"] = sg.integer("filter_order", 2, lo=1, hi=4)
+    kw["actuator"] = actuator_table(top.table("actuator"), kw["controls"])
 
     sim = top.table("simulation").check_keys(
         (),
@@ -276,7 +281,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
             f"{n_samples} samples at simulation.sample_rate = {kw['sample_rate']:g} Hz, above "
             f"the limit of {MAX_SAMPLES} samples; shorten the run or lower the sample rate",
         )
-    kw["delay"] = sim.boolean("delay", False)
+    kw["delay"] = sim.boolean("delay", True)
     kw["seed"] = sim.integer("seed", 0, lo=0, hi=2**32 - 1)
     kw["sensor_noise"] = sim.number_map("sensor_noise", quantity="variance")
 

@@ -17,7 +17,38 @@ from .controller_file import load_controller
 from .toml_tables import Table
 from .user_files import read_text
 
-__all__ = ["flight", "disturbance", "trade_table", "controller", "is_file"]
+__all__ = ["flight", "disturbance", "trade_table", "controller", "is_file", "actuator_table"]
+
+ACTUATOR_KEYS = ("order", "bandwidth_hz", "damping", "pole_hz", "source")
+
+
+def actuator_table(tbl: Table, controls) -> dict | None:
+    """``[actuator]``: one actuator for every control (keys :data:`ACTUATOR_KEYS`), or one
+    sub-table per control name; None when absent (ideal actuators)."""
+    from ..design.actuator import ActuatorDynamics
+
+    if not tbl.data:
+        return None
+    per_control = all(isinstance(v, dict) for v in tbl.data.values())
+    tables = {c: tbl.table(c) for c in tbl.data} if per_control else dict.fromkeys(controls, tbl)
+    out = {}
+    for name, t in tables.items():
+        if name not in controls:
+            tbl.fail(name, t.data, f"not a control of this scenario; controls {list(controls)}")
+        t.check_keys(("order", "bandwidth_hz"), ACTUATOR_KEYS[2:])
+        order = t.integer("order", lo=1, hi=3)
+        two_pi = 2.0 * np.pi
+        pole = t.number("pole_hz", unit="Hz", lo=0.0, hi=1e4, lo_open=True)
+        if pole is not None and order != 3:
+            t.fail("pole_hz", pole, "only an order-3 actuator has a real pole")
+        out[name] = ActuatorDynamics(
+            order,
+            two_pi * t.number("bandwidth_hz", unit="Hz", lo=0.0, hi=1e4, lo_open=True),
+            t.number("damping", 0.7, lo=0.0, hi=10.0, lo_open=True),
+            None if pole is None else two_pi * pole,
+        )
+        t.string("source", "")
+    return out
 
 
 def disturbance(tbl: Table, base: Path, span: float) -> Disturbance:

@@ -22,6 +22,7 @@ from ..design.sampled_loop import linear_law, plant_states
 from ..errors import RANGES, InputError, check_int, check_number
 from ..linear.models import SAMPLE_RATES, check_continuous
 from ..linear.signals import check_names, describe
+from .actuator_limits import ActuatorLimits
 from .result import SimulationResult, windup_text
 from .stepping import march_loop
 
@@ -72,7 +73,10 @@ def simulate(
     disturbance : callable, optional
         ``w(t, speed)`` gust velocity [m/s], e.g. :class:`aeroservo.aero.gusts.OneMinusCosine`.
     limits : Limits, optional
-        Actuator magnitude and rate limits.
+        Magnitude and rate limits of each control: on its command, or, where the plant has an
+        actuator on it (:mod:`aeroservo.design.actuator`), on the actuator's output (position
+        and rate, :mod:`aeroservo.simulate.actuator_limits`), the command keeping the
+        magnitude limit.
     delay : bool
         One-sample computational delay.
     sensor_noise : dict, optional
@@ -156,7 +160,11 @@ def simulate(
             )
         d[:, 0] = w
     x = np.zeros(sp.n_states) if x0 is None else _initial_state(x0, sp.n_states)
-    mag, rate = limits.arrays(controls)
+    act = None
+    mag, rate, actuated = ActuatorLimits.command_limits(plant, controls, *limits.arrays(controls))
+    if actuated:  # the limits bound the actuator outputs
+        act = ActuatorLimits(plant, controls, *limits.arrays(controls), dt)
+        act = act if act.parts else None
     s_idx = [out_names.index(s) for s in sensors]
     rec_idx = [i for i, n in enumerate(out_names) if n in rec]
     noise = None
@@ -181,12 +189,16 @@ def simulate(
         delay,
         n_steps,
         record_states,
+        act,
     )
     wall = time.perf_counter() - t0
     units = dict(getattr(plant, "signal_units", {}))
+    recorded = {out_names[i]: Y[:, j] for j, i in enumerate(rec_idx)}
+    if act is not None:
+        act.recorded_rates(recorded)
     result = SimulationResult(
         t=t,
-        outputs={out_names[i]: Y[:, j] for j, i in enumerate(rec_idx)},
+        outputs=recorded,
         commands={c: Cmd[:, i] for i, c in enumerate(controls)},
         applied={c: U[:, i] for i, c in enumerate(controls)},
         disturbance={n: d[:, i] for i, n in enumerate(dist)},

@@ -124,14 +124,31 @@ class SimulationResult:
         known = list(self.outputs) + list(self.applied) + list(self.disturbance)
         raise InputError(f"signal {name!r}: not recorded; known: {known}")
 
+    def at_limits(self) -> dict:
+        """``{control: (at_magnitude, at_rate)}``: boolean arrays of the samples where what the
+        plant receives sat on its magnitude limit and where it moved at its rate limit. With an
+        actuator (outputs ``<c>_actuator``, ``<c>_actuator_rate``) that is its output; else the
+        applied command (rate: its step from the previous sample, the first from zero)."""
+        mag, rate = self.limits.arrays(list(self.applied))
+        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
+        out = {}
+        for i, (c, u) in enumerate(self.applied.items()):
+            y, r = self.outputs.get(c + "_actuator"), self.outputs.get(c + "_actuator_rate")
+            if y is not None and r is not None:  # at the stop, or the command clipped
+                at_mag = (np.abs(y) >= mag[i] * (1 - 1e-12)) | (np.abs(u) >= mag[i] * (1 - 1e-12))
+                at_rate = np.isfinite(rate[i]) & (np.abs(r) >= rate[i] * (1 - 1e-9))
+            else:
+                u = np.asarray(u, dtype=float)
+                at_mag = np.abs(u) >= mag[i] * (1 - 1e-12)
+                step = np.abs(np.diff(np.r_[0.0, u]))
+                at_rate = np.isfinite(rate[i]) & (step >= rate[i] * dt * (1 - 1e-9)) & (dt > 0)
+            out[c] = (at_mag, at_rate)
+        return out
+
     @property
     def saturated_fraction(self) -> dict:
         """Share of samples at which each control sat on its magnitude limit [-]."""
-        mag, _ = self.limits.arrays(list(self.applied))
-        return {
-            c: float(np.mean(np.abs(u) >= mag[i] * (1 - 1e-12)))
-            for i, (c, u) in enumerate(self.applied.items())
-        }
+        return {c: float(np.mean(m)) for c, (m, _) in self.at_limits().items()}
 
     def windup(self, ratio: float = WINDUP_RATIO) -> dict:
         """Controls whose commands ran away beyond their magnitude limit: ``{control:
@@ -154,31 +171,15 @@ class SimulationResult:
 
     @property
     def rate_limited_fraction(self) -> dict:
-        """Share of samples at which each control moved at its rate limit (the command was
-        rate-limited; the first sample starts from zero)."""
-        _, rate = self.limits.arrays(list(self.applied))
-        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
-        out = {}
-        for i, (c, u) in enumerate(self.applied.items()):
-            step = np.abs(np.diff(np.r_[0.0, np.asarray(u, dtype=float)]))
-            limited = np.isfinite(rate[i]) & (step >= rate[i] * dt * (1 - 1e-9))
-            out[c] = float(np.mean(limited)) if dt > 0 else 0.0
-        return out
+        """Share of samples at which each control moved at its rate limit [-]."""
+        return {c: float(np.mean(r)) for c, (_, r) in self.at_limits().items()}
 
     def time_at_limit(self) -> dict:
-        """Time [s] each control spent at its magnitude or rate limit: the samples at either
-        (as :attr:`saturated_fraction` and :attr:`rate_limited_fraction` count them) times the
-        sample period (a measure that does not depend on the length of the march)."""
-        mag, rate = self.limits.arrays(list(self.applied))
+        """Time [s] each control spent at its magnitude or rate limit (:meth:`at_limits`):
+        the samples at either times the sample period (a measure that does not depend on the
+        length of the march)."""
         dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
-        out = {}
-        for i, (c, u) in enumerate(self.applied.items()):
-            u = np.asarray(u, dtype=float)
-            at_mag = np.abs(u) >= mag[i] * (1 - 1e-12)
-            step = np.abs(np.diff(np.r_[0.0, u]))
-            at_rate = np.isfinite(rate[i]) & (step >= rate[i] * dt * (1 - 1e-9))
-            out[c] = float(np.count_nonzero(at_mag | at_rate)) * dt
-        return out
+        return {c: float(np.count_nonzero(m | r)) * dt for c, (m, r) in self.at_limits().items()}
 
     def plot(
         self,
@@ -247,8 +248,10 @@ class SimulationResult:
     def _control_panel(self, ax, name: str, k: float, unit: str) -> None:
         """Applied and commanded input, the axis scaled to the applied input; the limits drawn
         when near it, else named (see :meth:`plot`)."""
-        applied, command = k * self.applied[name], k * self.commands[name]
-        ax.plot(self.t, applied, label="applied")
+        act = self.outputs.get(name + "_actuator")  # with an actuator: its output is applied
+        applied = k * (self.applied[name] if act is None else act)
+        command = k * self.commands[name]
+        ax.plot(self.t, applied, label="applied" if act is None else "actuator output (applied)")
         ax.plot(self.t, command, "--", lw=0.8, label="commanded")
         peak = float(np.max(np.abs(applied), initial=0.0))
         mag = self.limits.magnitude.get(name)

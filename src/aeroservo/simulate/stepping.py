@@ -75,8 +75,9 @@ def _checked(c, m: int, controller) -> np.ndarray:
 
 
 def march_loop(
-    sp, controller, law, x0, d, noise, s_idx, rec_idx, mag, rate_dt, delay, n_steps, rec
-):
+    sp, controller, law, x0, d, noise, s_idx, rec_idx, mag, rate_dt, delay, n_steps, rec,
+    act=None,
+):  # fmt: skip
     """The sampled loop: ``(outputs, states or None, applied, commands, status)`` per sample.
 
     A linear law (:class:`~aeroservo.design.law.LinearLaw`, delay included) is marched by one
@@ -86,7 +87,10 @@ def march_loop(
     applied. With one control the limits are applied on Python floats (the same comparisons as
     ``np.maximum``/``np.minimum``, without the overhead of ufunc calls on one-element arrays).
     The recorded outputs are computed per block of samples from the states,
-    ``y[k] = C x[k] + Du u[k-1] + Dd d[k]``.
+    ``y[k] = C x[k] + Du u[k-1] + Dd d[k]``. ``act``
+    (:class:`~aeroservo.simulate.actuator_limits.ActuatorLimits`) corrects the state at the
+    end of a sample in which an actuator output reaches its limits, and the measurements that
+    follow from it.
     """
     Phi, Gu, Gd = sp.Phi, sp.Gu, sp.Gd
     n, m = Gu.shape
@@ -117,6 +121,15 @@ def march_loop(
         row0 = np.zeros(width)
         row0[ix], row0[irb] = x0, S @ x0
     C_rec = sp.C[rec_idx]
+    W = None
+    if act is not None:  # the head of a row as a function of its state: for the corrections
+        W = np.zeros((ihead, n))
+        W[ix] = np.eye(n)
+        if law is not None:
+            W[irb], W[iq] = B @ Cm, D @ Cm
+        else:
+            W[irb] = S
+        clamp = act.clamp
 
     Y = np.empty((n_steps + 1, len(rec_idx)))
     X = np.empty((n_steps + 1, n)) if rec else None
@@ -152,6 +165,10 @@ def march_loop(
                 zk[i0] = u
                 dot(M, zk, zk1)
                 hs = u
+                if W is not None:
+                    dx = clamp(zk[ix], (u,), zk1)
+                    if dx is not None:
+                        zk1 += W @ dx
         elif law is not None:
             for zk, zk1, ck in zip(Z[:nb], head[1 : nb + 1], cmd, strict=True):
                 c = zk[iq] + zk[iad]
@@ -161,6 +178,10 @@ def march_loop(
                 zk[iu] = u
                 dot(M, zk, zk1)
                 h = u
+                if W is not None:
+                    dx = clamp(zk[ix], u, zk1)
+                    if dx is not None:
+                        zk1 += W @ dx
         else:
             for zk, zk1, ak, ck in zip(Z[:nb], head[1 : nb + 1], a[k0 : k0 + nb], cmd, strict=True):
                 ys = zk[irb] + ak
@@ -178,6 +199,10 @@ def march_loop(
                 zk[iu] = u
                 dot(M, zk, zk1)
                 h = u
+                if W is not None:
+                    dx = clamp(zk[ix], u, zk1)
+                    if dx is not None:
+                        zk1 += W @ dx
         Y[k0 : k0 + nb] = _rows_times(Z[:nb, :n], C_rec)
         if X is not None:
             X[k0 : k0 + nb] = Z[:nb, :n]

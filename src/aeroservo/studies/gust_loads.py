@@ -109,7 +109,12 @@ class GustLoadsStudy:
         Where a spec is designed: mass case, density [kg/m^3] and true airspeed [m/s] (or
         ``design_speed_factor`` x the open-loop flutter speed there).
     limits : aeroservo.design.Limits or None
-        Actuator limits of the closed loop (default: those of a spec; none for an object).
+        Actuator limits of the closed loop (default: those of a spec; none for an object): on the
+        actuator output where ``actuator`` gives one.
+    delay : bool
+        One-sample computational delay of the closed loop (default on).
+    actuator : ActuatorDynamics, dict of ActuatorDynamics or None
+        Actuator dynamics in series with the controls (:mod:`aeroservo.design.actuator`).
     f_g : float or None
         Flight profile alleviation factor; None: from ``weights`` at each altitude.
     weights : dict
@@ -153,7 +158,8 @@ class GustLoadsStudy:
     sensor_filter: float | None = 30.0
     filter_order: int = 2
     sample_rate: float = 1000.0
-    delay: bool = False
+    delay: bool = True
+    actuator: object = None
     n_gradients: int = 20
     turbulence: bool = True
     name: str = "gust_loads"
@@ -286,4 +292,5 @@ class GustLoadsStudy:
             sensor_filter=self.sensor_filter,
             filter_order=self.filter_order,
             gust=self.gust_model,
+            actuator=self.actuator if self.controls else None,
         )

@@ -68,6 +68,7 @@ def gust_study(scenario: Scenario):
         filter_order=scenario.filter_order,
         sample_rate=scenario.sample_rate,
         delay=scenario.delay,
+        actuator=scenario.actuator if loop else None,
         n_gradients=g["n_gradients"],
         turbulence=g["turbulence"],
         name=scenario.result,

@@ -383,6 +383,8 @@ def study_from_scenario(scenario: Scenario):
         gust_model=scenario.gust_model,
         controller=t["controller"],
         sample_rate=scenario.sample_rate,
+        delay=scenario.delay,
+        actuator=scenario.actuator,
         parameters=dict(t["parameters"]),
         speed_factor=t["speed_factor"],
         gust_length=t["gust_length"],

@@ -83,11 +83,12 @@ class Scenario:
     outputs: tuple = ()
     sensor_filter: float | None = 30.0
     filter_order: int = 2
+    actuator: dict | None = None  # ActuatorDynamics by control ([actuator]); None: ideal
     disturbance: Disturbance = field(default_factory=Disturbance)
     controller: ControllerSpec | None = None
     duration: float = 2.0
     sample_rate: float = 1000.0
-    delay: bool = False
+    delay: bool = True  # one-sample computational delay ([simulation] delay)
     expect_failure: bool = False
     engaged_speeds: tuple | None = None
     engaged_speed_factors: tuple | None = None
@@ -170,6 +171,7 @@ class Scenario:
             sensor_filter=self.sensor_filter,
             filter_order=self.filter_order,
             gust=self.gust_model,
+            actuator=self.actuator,
         )
 
 

@@ -102,6 +102,7 @@ def _loop(study: TradeStudy, entry: dict):
         study.sensor_filter,
         study.filter_order,
         study.gust_model,
+        tuple(sorted((study.actuator or {}).items())),
     )
     if key not in entry["loops"]:
         entry["loops"][key] = ControlLoop(
@@ -114,6 +115,7 @@ def _loop(study: TradeStudy, entry: dict):
             sensor_filter=study.sensor_filter,
             filter_order=study.filter_order,
             gust=study.gust_model,
+            actuator=study.actuator,
         )
     return entry["loops"][key]
 
@@ -224,7 +226,9 @@ def _closed_loop(
     ctrl = loop.design_controller(spec, speed, study.sample_rate, v_ol)
 
     stage[0] = "closed_loop"
-    b = closed_loop_boundary(loop, ctrl, v_max, n_grid=study.n_grid, reference_speed=speed)
+    b = closed_loop_boundary(
+        loop, ctrl, v_max, n_grid=study.n_grid, reference_speed=speed, delay=study.delay
+    )
     stable = b.stable_at_reference
     if stable:
         onset = b.flutter
@@ -241,7 +245,8 @@ def _closed_loop(
         from ...design.margins import loop_margins
 
         rec["closed_loop_lower_speed"] = _num(b.lower_speed)
-        ch = loop_margins(loop.plant(speed), ctrl, sensors=False).channels[study.controls[0]]
+        ch = loop_margins(loop.plant(speed), ctrl, sensors=False, delay=study.delay)
+        ch = ch.channels[study.controls[0]]
         for key in ("gain_margin_db", "gain_reduction_margin_db", "phase_margin_deg"):
             rec[key] = _num(getattr(ch, key))
         rec["disk_margin"] = _num(ch.disk_margin)
@@ -249,15 +254,19 @@ def _closed_loop(
     stage[0] = "gust"
     gust = OneMinusCosine(study.gust_length, study.gust_amplitude, 0.0)
     control = study.controls[0]
+    plant = loop.plant(speed)
+    applied = [n for n in (control + "_actuator",) if n in plant.output_labels]
     sim = simulate(
-        loop.plant(speed),
+        plant,
         ctrl,
         duration=study.gust_duration,
         disturbance=gust,
         limits=spec.limits,
-        outputs=["tip_accel"],
+        delay=study.delay,
+        outputs=["tip_accel"] + applied,
     )
-    u = np.asarray(sim.applied[control], dtype=float)
+    u = sim.outputs.get(control + "_actuator", sim.applied[control])  # what the surface gets
+    u = np.asarray(u, dtype=float)
     a = np.asarray(sim.outputs["tip_accel"], dtype=float)
     rec["hinge_moment_peak"] = _num(np.max(np.abs(u)))
     rec["hinge_moment_rms"] = _num(np.sqrt(np.mean(u**2)))

@@ -8,9 +8,8 @@ one aileron and of its flutter-suppression controller (:data:`PARAMETERS`). Each
   ``speed_factor`` x the open-loop flutter speed, and the suppression margin
   ``V_cl / V_ol - 1`` [-];
 * peak and RMS hinge moment [N m] and tip acceleration [m/s^2] in a 1-cos gust, closed loop,
-  at the design speed, with the controller's actuator limits applied;
-* the wall time [s] and, for a failed case, the stage and the message (a failed case is
-  recorded, never lost).
+  at the design speed, with the actuator and its limits; the wall time [s] and, for a failed
+  case, the stage and the message (a failed case is recorded, never lost).
 
 :func:`run_trade` evaluates the cases on a Dask cluster: a ``distributed.LocalCluster`` on this
 machine by default (worker processes, one thread each, BLAS/OpenMP pools limited to one thread
@@ -30,8 +29,7 @@ compiled NetCDF/HDF5 library, only SciPy, already a dependency. The same cases a
 written as a flat CSV table (one row per case) for spreadsheets. ``out_dir/study.json``
 describes the study so that :func:`load_trade` can re-read it for re-plotting.
 
-Dask, xarray and pandas are imported only when needed (``import aeroservo`` stays fast); they
-come with the ``trade`` extra.
+Dask, xarray and pandas are imported only when needed; they come with the ``trade`` extra.
 """
 
 from __future__ import annotations
@@ -45,8 +43,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...design.actuator import actuators_of
 from ...design.spec import ControllerSpec
 from ...errors import MAX_ELEMENTS, InputError, check_int, check_number
+from ...linear.signals import check_names
 from ...structure.wing import Wing
 from ...system.damping import NO_DAMPING, StructuralDamping
 from .mass_parameters import TradeParameters, check_mass_values, mass_parameter
@@ -173,6 +173,9 @@ class TradeStudy:
         Needed unless ``closed_loop`` is False.
     sample_rate : float
         Controller sample rate [Hz].
+    delay, actuator : bool, ActuatorDynamics (or a dict of them by control) or None
+        One-sample computational delay (default on) and actuator dynamics (default ideal) of
+        every loop (:mod:`aeroservo.design.actuator`: the limits bound its output).
     parameters : dict
         ``{name: values}`` of the swept parameters (names from :data:`PARAMETERS`); the grid is
         their full product, in this order, the last varying fastest.
@@ -210,6 +213,8 @@ class TradeStudy:
     gust_model: str = "kussner"
     controller: ControllerSpec | None = None
     sample_rate: float = 1000.0
+    delay: bool = True
+    actuator: object = None
     parameters: dict = field(default_factory=dict)
     speed_factor: float = 1.1
     gust_length: float = 25.0
@@ -225,6 +230,9 @@ class TradeStudy:
         from ...aero.indicial import wagner_set
 
         put = object.__setattr__
+        actuators_of(self.actuator, self.controls)  # checked here, not in every case
+        if not isinstance(self.delay, bool):
+            raise InputError(f"delay = {self.delay!r}: expected True or False")
         w = self.base_wing
         if not isinstance(w, Wing):
             raise InputError(f"base_wing = {w!r}: expected an aeroservo.Wing")
@@ -385,12 +393,8 @@ class TradeStudy:
 
 
 def _names(key: str, value: object) -> tuple[str, ...]:
-    if isinstance(value, str) or not isinstance(value, (Sequence, set, frozenset)):
-        raise InputError(f"{key} = {value!r}: expected a list of signal names")
-    value = tuple(value)
-    for i, n in enumerate(value):
-        if not isinstance(n, str) or not n:
-            raise InputError(f"{key}[{i}] = {n!r}: expected a signal name")
+    value = tuple(check_names(key, list(value) if isinstance(value, (set, frozenset)) else value,
+                              empty=True))  # fmt: skip
     if len(set(value)) != len(value):
         raise InputError(f"{key} = {list(value)}: repeated names")
     return value
