@@ -113,13 +113,16 @@ def test_margins_match_a_series_built_by_python_control(model):
     mine = _loop(model, act).plant(130.0)
     K = static_gain(np.array([[-2e4]]), [HM], sensors=["tip_twist"], sample_rate=1000.0, sign=-1)
     for delay in (False, True):
-        a = loop_margins(mine, K, delay=delay).channels[HM]
-        b = loop_margins(hand, K, delay=delay).channels[HM]
-        assert a.stable == b.stable
-        for key in ("gain_margin_db", "gain_reduction_margin_db", "phase_margin_deg"):
-            x, y = getattr(a, key), getattr(b, key)
-            assert x == pytest.approx(y, rel=1e-6, abs=1e-6), key
-        assert a.delay_margin == pytest.approx(b.delay_margin, rel=1e-6)
+        ma, mb = loop_margins(mine, K, delay=delay), loop_margins(hand, K, delay=delay)
+        pairs = [(ma.channels[HM], mb.channels[HM])]  # at the actuator command
+        pairs += [(ma.sensors[s], mb.sensors[s]) for s in mb.sensors]  # and at the sensor
+        assert len(pairs) == 2
+        for a, b in pairs:
+            assert a.stable == b.stable
+            for key in ("gain_margin_db", "gain_reduction_margin_db", "phase_margin_deg"):
+                x, y = getattr(a, key), getattr(b, key)
+                assert x == pytest.approx(y, rel=1e-6, abs=1e-6), key
+            assert a.delay_margin == pytest.approx(b.delay_margin, rel=1e-6)
 
 
 def _reference_march(P, x0, K, mag, rate, duration, dt=1e-3, sub=100):

@@ -226,7 +226,7 @@ def as_given(mats, family: int):
 
 @pytest.mark.slow
 def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
-    """20 random linear controllers on the Goland-with-aileron plant (the shipped H-infinity
+    """12 random linear controllers on the Goland-with-aileron plant (the shipped H-infinity
     compensator rescaled, its state transformed, random stable poles added: a filter in series,
     a lightly damped pair in parallel or both; random static gains on the sensors), given as a
     ``DiscreteCompensator``, a python-control ``StateSpace`` or a ``static_gain``, kept when
@@ -240,7 +240,7 @@ def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
     speeds = np.linspace(v_min, v_max, 301)
     rng = np.random.default_rng(20240624)
     kept, tries = [], 0
-    while len(kept) < 20:
+    while len(kept) < 12:  # three of each of the four families
         tries += 1
         assert tries < 200, "too few random controllers are stable at their reference speed"
         family = len(kept) % 4
@@ -272,7 +272,7 @@ def test_random_compensators_boundary_matches_dense_eigenvalues(setup):
             assert (a, c) == pytest.approx((a0, c0), rel=1e-5), what
         n_cross.append(len(expected))
     print(
-        f"20 controllers ({tries} drawn), crossings per controller {n_cross}: worst relative "
+        f"12 controllers ({tries} drawn), crossings per controller {n_cross}: worst relative "
         f"speed error {worst:.2e}, worst frequency error {worst_freq:.2e} Hz"
     )
 

@@ -77,33 +77,60 @@ class _One:
         self.pred_P = np.vstack([Ps[:, 0, :], rP])
         self.pred_Q = np.concatenate([Qs[:, 0], rQ])
         self.end_P, self.end_Q = Ps[-1], Qs[-1]
+        # a bound of |position| and |rate| over the substeps, cheap enough for every sample:
+        # |y_j| <= sum_i max_j |P_j[i]| |x0_i| + max_j |Q_j| |c| (likewise the rate)
+        self._bound_y = (np.abs(Ps[:, 0, :]).max(axis=0).tolist(), float(np.abs(Qs[:, 0]).max()))
+        self._bound_r = (np.abs(rP).max(axis=0).tolist(), float(np.abs(rQ).max()))
+        self._phi = self.Phi.tolist()
+        self._g = self.G.tolist()
         rest = np.setdiff1d(np.arange(A.shape[0]), self.idx)
         self.rest = rest
         self.F = _foh_weights(A[np.ix_(rest, rest)], A[rest, idx[0]], h, M)
 
+    def _within(self, x0: list, c: float) -> bool:
+        """Whether the bound proves the linear sample within both limits."""
+        ay, by = self._bound_y
+        ar, br = self._bound_r
+        ac = abs(c)
+        y = by * ac + sum(a * abs(v) for a, v in zip(ay, x0, strict=True))
+        r = br * ac + sum(a * abs(v) for a, v in zip(ar, x0, strict=True))
+        return y <= self.mag and r <= self.rate
+
     def correction(self, xa0: np.ndarray, c: float):
         """``None`` if the linear sample keeps within the limits, else ``(dx_rest, dx_act)``."""
+        x0 = xa0.tolist()
+        if self._within(x0, c):
+            return None
         pred = self.pred_P @ xa0 + self.pred_Q * c
         M = self.M
         if np.all(np.abs(pred[:M]) <= self.mag) and np.all(np.abs(pred[M:]) <= self.rate):
             return None
-        x = xa0.copy()
-        ys = np.empty(M)
-        rh, mag = self.rate * self.h, self.mag
-        for j in range(M):
+        ys = self._clamped(x0, c)
+        x = np.array(self._last)
+        dy = np.asarray(ys) - pred[:M]
+        return self.F.T @ dy, x - (self.end_P @ xa0 + self.end_Q * c)
+
+    def _clamped(self, x: list, c: float) -> list:
+        """The clamped substep positions (Python floats: the actuator has 1-3 states); the
+        final state is kept in ``_last``."""
+        phi, g, k = self._phi, self._g, self.k
+        rate, mag, rh = self.rate, self.mag, self.rate * self.h
+        ys = []
+        for _ in range(self.M):
             y0 = x[0]
-            x = self.Phi @ x + self.G * c
-            if self.k == 1:
+            x = [sum(p * v for p, v in zip(row, x, strict=True)) + gi * c
+                 for row, gi in zip(phi, g, strict=True)]  # fmt: skip
+            if k == 1:
                 x[0] = min(max(x[0], y0 - rh), y0 + rh)
             else:
-                x[1] = min(max(x[1], -self.rate), self.rate)
+                x[1] = min(max(x[1], -rate), rate)
             if x[0] > mag or x[0] < -mag:
                 x[0] = mag if x[0] > 0 else -mag
-                if self.k > 1 and x[1] * x[0] > 0:
+                if k > 1 and x[1] * x[0] > 0:
                     x[1] = 0.0
-            ys[j] = x[0]
-        dy = ys - pred[:M]
-        return self.F.T @ dy, x - (self.end_P @ xa0 + self.end_Q * c)
+            ys.append(x[0])
+        self._last = x
+        return ys
 
 
 class ActuatorLimits:
