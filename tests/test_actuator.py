@@ -16,6 +16,7 @@ Independent checks written here:
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import control
@@ -303,6 +304,8 @@ def test_trade_study_carries_the_actuator_and_the_delay(tmp_path):
     assert plain.delay is True and plain.actuator is None
     assert act.actuator[HM].order == 2
     assert case_id(plain, {}) != case_id(act, {})  # new settings, new case files
+    one = dataclasses.replace(plain, actuator=ActuatorDynamics(1, 100.0))  # one for all
+    assert one.actuator == {HM: ActuatorDynamics(1, 100.0)} and case_id(one, {})
 
 
 def test_hinge_march_refuses_a_loop_with_an_actuator(model):

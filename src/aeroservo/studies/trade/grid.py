@@ -80,9 +80,8 @@ def study_settings(study: TradeStudy) -> dict:
         if "speed_factor" not in study.parameters:
             s["speed_factor"] = study.speed_factor
         s["delay"] = study.delay
-        if study.actuator:  # only then: loops with ideal actuators keep their other settings
-            acts = study.actuator if isinstance(study.actuator, dict) else {"*": study.actuator}
-            s["actuator"] = {c: _jsonable(a) for c, a in sorted(acts.items())}
+        if study.actuator:  # by control (TradeStudy makes it a dict)
+            s["actuator"] = {c: _jsonable(a) for c, a in sorted(study.actuator.items())}
     return s
 
 

@@ -230,7 +230,7 @@ class TradeStudy:
         from ...aero.indicial import wagner_set
 
         put = object.__setattr__
-        actuators_of(self.actuator, self.controls)  # checked here, not in every case
+        put(self, "actuator", actuators_of(self.actuator, self.controls) or None)  # by control
         if not isinstance(self.delay, bool):
             raise InputError(f"delay = {self.delay!r}: expected True or False")
         w = self.base_wing
