@@ -28,8 +28,11 @@ lint: install
 	$(BIN)/ruff check src tests bench
 	$(BIN)/ruff format --check src tests bench
 
+# two workers (the 2-core machine the suite is budgeted on), one module per worker at a time
+# (module fixtures built once), one BLAS thread each (no oversubscription)
 test: lint
-	$(BIN)/python -m pytest
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
+		$(BIN)/python -m pytest -n 2 --dist loadscope
 
 # every target of the performance issues with its ratio to a same-run baseline and PASS/FAIL
 bench: install
