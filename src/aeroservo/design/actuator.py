@@ -30,7 +30,15 @@ import numpy as np
 from ..errors import InputError, check_number
 from ..linear.signals import describe
 
-__all__ = ["ActuatorDynamics", "actuator_arrays", "actuator_labels", "actuators_of", "MAX_ACTUATOR"]
+__all__ = [
+    "ActuatorDynamics",
+    "actuator_arrays",
+    "actuator_labels",
+    "actuator_outputs",
+    "actuators_of",
+    "MAX_ACTUATOR",
+    "STATE_SUFFIXES",
+]
 
 MAX_ACTUATOR = 1.0e5
 """Largest actuator frequency [rad/s] (beyond it an actuator is ideal for any flutter loop)."""
@@ -121,12 +129,19 @@ class ActuatorDynamics:
         )
 
 
-_SUFFIXES = ("_actuator", "_actuator_rate", "_actuator_lag")
+STATE_SUFFIXES = ("_actuator", "_actuator_rate", "_actuator_lag")
+"""Suffixes of an actuator's states on a control: position, rate, lag (the first two are also
+its outputs)."""
 
 
 def actuator_labels(control: str, actuator: ActuatorDynamics) -> list[str]:
     """State names of ``actuator`` on ``control`` (position, rate, lag)."""
-    return [control + s for s in _SUFFIXES[: actuator.order]]
+    return [control + s for s in STATE_SUFFIXES[: actuator.order]]
+
+
+def actuator_outputs(controls) -> list[str]:
+    """Output names of the actuators on ``controls``: position and rate of each, in order."""
+    return [c + s for c in controls for s in STATE_SUFFIXES[:2]]
 
 
 def actuators_of(actuator, controls: Sequence[str]) -> dict[str, ActuatorDynamics]:

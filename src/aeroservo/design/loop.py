@@ -24,7 +24,7 @@ from ..errors import InputError, check_int, check_number
 from ..linear.models import tip_deflection_state
 from ..linear.state_space import StateSpaceBuilder
 from ..linear.tags import carry_tags
-from .actuator import actuator_arrays, actuator_labels, actuators_of
+from .actuator import actuator_arrays, actuator_labels, actuator_outputs, actuators_of
 from .compensator import compensator_from_lti
 from .hinf import hinf
 from .interface import python_law, static_gain
@@ -133,9 +133,8 @@ class ControlLoop:
 
         arrays = actuator_arrays(*(np.asarray(x) for x in control.ssdata(sys)),
                                  self._act_columns, list(self.actuators.values()))  # fmt: skip
-        extra = [c + s for c in self.actuators for s in ("_actuator", "_actuator_rate")]
         out = control.ss(*arrays, inputs=list(sys.input_labels),
-                         outputs=list(sys.output_labels) + extra,
+                         outputs=list(sys.output_labels) + actuator_outputs(self.actuators),
                          states=list(sys.state_labels) + self._actuator_states)  # fmt: skip
         carry_tags(sys, out)
         out.signal_units = {**getattr(sys, "signal_units", {}), **self._actuator_units}
@@ -144,9 +143,8 @@ class ControlLoop:
     @property
     def _actuator_units(self) -> dict:
         u = self.plant_builder.units
-        return {k: v for c in self.actuators
-                for k, v in ((f"{c}_actuator", u[c]),
-                             (f"{c}_actuator_rate", f"{u[c]}/s"))}  # fmt: skip
+        units = [x for c in self.actuators for x in (u[c], f"{u[c]}/s")]
+        return dict(zip(actuator_outputs(self.actuators), units, strict=True))
 
     @property
     def _actuator_states(self) -> list[str]:
@@ -181,7 +179,7 @@ class ControlLoop:
         if self.actuators:
             acts = list(self.actuators.values())
             arrays = actuator_arrays(*arrays, self._act_columns, acts)
-            outs += tuple(c + s for c in self.actuators for s in ("_actuator", "_actuator_rate"))
+            outs += tuple(actuator_outputs(self.actuators))
         labels = (self.plant_builder.input_labels, outs)
         sp = SampledPlant.from_arrays(arrays, labels, dt, controls, (), outputs)
         self._sampled[key] = sp

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 import scipy.linalg as sla
 
+from ..design.actuator import STATE_SUFFIXES
 from ..design.plant import zoh
 
 __all__ = ["ActuatorLimits", "SUBSTEP"]
@@ -157,8 +158,7 @@ class ActuatorLimits:
         for i, c in enumerate(controls):
             if c + "_actuator" not in states or not (np.isfinite(mag[i]) or np.isfinite(rate[i])):
                 continue
-            idx = [states.index(c + s) for s in ("_actuator", "_actuator_rate", "_actuator_lag")
-                   if c + s in states]  # fmt: skip
+            idx = [states.index(c + s) for s in STATE_SUFFIXES if c + s in states]
             self.parts.append((i, _One(A, B, idx, inputs.index(c), mag[i], rate[i], dt)))
         self.controls = list(controls)
 

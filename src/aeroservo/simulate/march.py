@@ -161,9 +161,10 @@ def simulate(
         d[:, 0] = w
     x = np.zeros(sp.n_states) if x0 is None else _initial_state(x0, sp.n_states)
     act = None
-    mag, rate, actuated = ActuatorLimits.command_limits(plant, controls, *limits.arrays(controls))
+    bounds = limits.arrays(controls)
+    mag, rate, actuated = ActuatorLimits.command_limits(plant, controls, *bounds)
     if actuated:  # the limits bound the actuator outputs
-        act = ActuatorLimits(plant, controls, *limits.arrays(controls), dt)
+        act = ActuatorLimits(plant, controls, *bounds, dt)
         act = act if act.parts else None
     s_idx = [out_names.index(s) for s in sensors]
     rec_idx = [i for i, n in enumerate(out_names) if n in rec]
