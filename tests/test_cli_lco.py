@@ -101,17 +101,17 @@ def _same(a, b) -> bool:
 def test_shipped_scenarios_load():
     sc = load_scenario(SHIPPED)
     assert sc.kind == "lco" and sc.wing is None and sc.section.k_flap == pytest.approx(3.9)
-    assert sc.lco["speeds"] == tuple(float(v) for v in range(4, 27))
-    assert sc.lco["hinges"] == (NonlinearHinge("flap", Freeplay(GAP)),)
+    assert sc.lco.speeds == tuple(float(v) for v in range(4, 27))
+    assert sc.lco.hinges == (NonlinearHinge("flap", Freeplay(GAP)),)
     setup, sweep = lco_setup(quick(sc))
     assert sweep.speeds == (4.0, 15.0, 26.0) and sweep.amplitudes == (0.0185, 0.222)
     assert sweep.duration == 2.0 and setup.elements.names == ("flap",)
     ol = load_scenario(ROOT / "scenarios" / "goland_aileron_freeplay_lco.toml")
-    assert ol.controller is None and len(ol.lco["speeds"]) == 8
+    assert ol.controller is None and len(ol.lco.speeds) == 8
     lqr = load_scenario(ROOT / "scenarios" / "goland_aileron_freeplay_lqr.toml")
     assert lqr.controller.type == "lqr" and lqr.speed_factor == 1.1
     for s in (ol, lqr):  # both aileron actuators, named as in the built-in wing
-        assert s.lco["hinges"] == (NonlinearHinge("aileron", Freeplay(0.01745)),)
+        assert s.lco.hinges == (NonlinearHinge("aileron", Freeplay(0.01745)),)
         names = [a.name for cs in s.wing.control_surfaces for a in cs.actuators]
         assert names == [a.name for a in goland_aileron().control_surfaces[0].actuators]
 
@@ -384,8 +384,8 @@ def test_hinges_from_a_wing_file(tmp_path, capsys):
     path = tmp_path / "w.toml"
     path.write_text(ON_WING.format(wing=wing, hinges=""))
     sc = load_scenario(path)
-    assert sc.lco["hinges"] == load_hinges(wing)
-    assert sc.lco["hinges_source"] == f"{wing} [[hinges]]"
+    assert sc.lco.hinges == load_hinges(wing)
+    assert sc.lco.hinges_source == f"{wing} [[hinges]]"
     out = tmp_path / "out"
     assert main(["lco", str(path), "--out", str(out), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
@@ -397,7 +397,7 @@ def test_hinges_from_a_wing_file(tmp_path, capsys):
     cubic = '[[lco.hinges]]\ntarget = "aileron"\nlaw = "cubic"\ncoefficient = 1.0e5\n'
     path.write_text(ON_WING.format(wing=wing, hinges=cubic))
     sc = load_scenario(path)
-    assert sc.lco["hinges"] == (NonlinearHinge("aileron", Cubic(1.0e5)),)
+    assert sc.lco.hinges == (NonlinearHinge("aileron", Cubic(1.0e5)),)
     setup, _ = lco_setup(sc)
     assert setup.elements.names == ("actuator1", "actuator2")
     # a bad table in the wing file names the wing file and its key, whoever reads it

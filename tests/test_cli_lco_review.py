@@ -270,7 +270,7 @@ def test_controller_of_type_none_is_the_open_loop(tmp_path):
     path = tmp_path / "none.toml"
     path.write_text(text)
     sc = load_scenario(path)
-    assert sc.controller.type == "none" and sc.lco["dt"] == 0.0005 and sc.speed_factor is None
+    assert sc.controller.type == "none" and sc.lco.dt == 0.0005 and sc.speed_factor is None
     path.write_text(text.replace("density = 1.225 ", "density = 1.225\nspeed = 140.0"))
     with pytest.raises(InputError, match=r"flight\.speed = 140\.0: only with controller\.spec of"):
         load_scenario(path)

@@ -50,9 +50,9 @@ def api_run():
 def test_quick_settings():
     sc = load_scenario(EXAMPLE)
     q = quick(sc)
-    assert len(sc.gust_loads["points"]) == 4 and sc.gust_loads["n_gradients"] == 20
-    assert q.gust_loads["points"] == sc.gust_loads["points"][:2]
-    assert q.gust_loads["n_gradients"] == 5
+    assert len(sc.gust_loads.points) == 4 and sc.gust_loads.n_gradients == 20
+    assert q.gust_loads.points == sc.gust_loads.points[:2]
+    assert q.gust_loads.n_gradients == 5
     study = gust_study(sc)
     assert study.design_density == 1.225 and study.design_speed_factor == 1.1
     assert study.controller.limits.magnitude == {"aileron_hinge_moment": 2000.0}

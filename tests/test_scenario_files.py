@@ -104,7 +104,7 @@ def test_shipped_scenario_loads(name):
     if s.kind == "simulate":
         assert s.controller is not None
     if s.kind == "trade":
-        assert s.trade["parameters"]
+        assert s.trade.parameters
 
 
 @pytest.mark.parametrize("name", SHIPPED_CONTROLLERS)

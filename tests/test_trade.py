@@ -172,7 +172,7 @@ def test_default_local_cluster_open_loop(tmp_path):
         closed_loop=False,
         name="ol",
     )
-    r = trade.run_trade(st, tmp_path, n_workers=2, progress=False)
+    r = trade.run_trade(st, tmp_path, workers=2, progress=False)
     assert r.n_failed == 0 and r.n_cases == 2
     assert r.table["open_loop_flutter_speed"].iloc[0] == pytest.approx(137.3708, rel=1e-5)
     assert r.table["closed_loop_flutter_speed"].isna().all()

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ._lazy import lazy_attributes
 from ._version import __version__
-from .errors import InputError
+from .errors import AeroservoError, InputError, NumericalError, VerdictFailure
 
 _PUBLIC = {
     "Freeplay": "structure.hinge_laws",
@@ -19,6 +19,14 @@ _PUBLIC = {
     "march_hinges": "simulate.hinge_march",
     "nonlinear_plant": "linear.hinge_plant",
     "run_lco": "studies.lco_run",
+    "LCOSetup": "studies.lco",
+    "LCOSweep": "studies.lco",
+    "FlightPoint": "studies.gust_loads",
+    "GustLoadsStudy": "studies.gust_loads",
+    "run_gust_loads": "studies.gust_run",
+    "TradeStudy": "studies.trade.study",
+    "run_trade": "studies.trade.cluster",
+    "import_nastran": "files.nastran",
     "AeroelasticModel": "system.aeroelastic",
     "DoubletLattice": "aero.dlm_settings",
     "ConcentratedMass": "structure.masses",
@@ -58,7 +66,15 @@ _SUBPACKAGES = {
     "system": "system",
 }
 
-__all__ = ["__version__", "InputError", "examples", *sorted(_PUBLIC)]
+__all__ = [
+    "__version__",
+    "AeroservoError",
+    "InputError",
+    "NumericalError",
+    "VerdictFailure",
+    "examples",
+    *sorted(_PUBLIC),
+]
 
 
 __getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC, _SUBPACKAGES)

@@ -1,13 +1,59 @@
-"""Error types raised by aeroservo."""
+"""The errors aeroservo raises, each with the exit code the command line gives it, and the
+checks of user numbers.
+
+* :class:`InputError` (a ``ValueError``), exit code 2: bad input; the message names the file,
+  the key and the value.
+* :class:`NumericalError` (an ``ArithmeticError``), exit code 1: a computation that cannot be
+  completed.
+* :class:`VerdictFailure`, exit code 3: a design that fails the verdict it was judged by.
+
+All three derive from :class:`AeroservoError`; the built-in bases keep ``except ValueError`` and
+``except ArithmeticError`` working as before.
+"""
 
 from __future__ import annotations
 
 import math
 import re
 
+__all__ = [
+    "AeroservoError",
+    "InputError",
+    "NumericalError",
+    "VerdictFailure",
+    "check_number",
+    "check_int",
+    "parse_number",
+    "show_value",
+]
 
-class InputError(ValueError):
-    """Invalid user input: the message names the field, the value and what is allowed."""
+
+class AeroservoError(Exception):
+    """Base of aeroservo's errors; ``exit_code`` is what the command line returns for it."""
+
+    exit_code: int = 1
+
+
+class InputError(AeroservoError, ValueError):
+    """Invalid user input: the message names the field, the value and what is allowed
+    (exit code 2)."""
+
+    exit_code = 2
+
+
+class NumericalError(AeroservoError, ArithmeticError):
+    """A computation that cannot be completed on valid input: a solver that does not
+    converge, a defective eigenproblem, a march that diverges numerically (exit code 1)."""
+
+    exit_code = 1
+
+
+class VerdictFailure(AeroservoError):
+    """A design judged and found failing (an unstable closed loop, margins below the
+    requirement), where the scenario did not expect it (exit code 3). The message is the
+    verdict's one-line reason."""
+
+    exit_code = 3
 
 
 def check_number(

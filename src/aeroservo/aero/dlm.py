@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, check_number
+from ..errors import InputError, NumericalError, check_number
 from .lattice import Lattice
 
 __all__ = ["aics", "check_dlm_mach", "cache_folder", "DLM_MACH_WARN", "KERNELS"]
@@ -215,7 +215,7 @@ def _compute(lattice: Lattice, mach: float, k: np.ndarray, kernel: str, progress
         with ThreadPoolExecutor(max_workers=workers) as pool:
             list(pool.map(one, range(k.size)))
     if not np.all(np.isfinite(out)):
-        raise ArithmeticError(
+        raise NumericalError(
             "doublet-lattice AICs are not finite: boxes too thin or overlapping (check the box "
             "counts and the planform)"
         )

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 
 __all__ = ["RationalFit", "fit_roger", "fit_minimum_state", "fit_lags", "lag_roots", "RFA_KINDS"]
 
@@ -122,7 +122,7 @@ def _check(k: np.ndarray, Q: np.ndarray, roots: np.ndarray) -> tuple:
     if np.any(k < 0) or np.unique(k).size != k.size:
         raise InputError("rfa: reduced frequencies must be distinct and >= 0")
     if not np.all(np.isfinite(Q)):
-        raise ArithmeticError("rfa: the tabulated forces have NaN or infinite values")
+        raise NumericalError("rfa: the tabulated forces have NaN or infinite values")
     return k, Q, roots
 
 

@@ -1,12 +1,14 @@
 """The ``aeroservo`` command.
 
-Exit codes: 0 success, 2 usage or input error (one-line message), 1 numerical failure,
-3 a closed-loop simulation whose loop is unstable (unless the scenario expects it).
+Exit codes (:mod:`aeroservo.errors`): 0 success, 2 usage or input error (``InputError``, one
+line), 1 numerical failure (``NumericalError``, any ``ArithmeticError``), 3 a failed verdict
+(``VerdictFailure``: a closed loop that is unstable or misses its margins, unless the scenario
+expects it).
 Heavy packages (matplotlib, python-control, casadi) are imported only by the commands that
 need them. Commands: :mod:`.analysis` (``flutter``, ``envelope``, ``modes``),
-:mod:`.scenarios` (``run``, ``simulate``, ``trade``, ``examples``), :mod:`.loads` (``loads``),
-:mod:`.lco` (``lco``) and :mod:`.results` (``plot``, ``export``), :mod:`.importing`
-(``import nastran``).
+:mod:`.scenarios` (``run`` and each scenario kind's command, made from the registry of kinds:
+``simulate``, ``trade``, ``loads``, ``lco``; ``examples``) and :mod:`.results` (``plot``,
+``export``), :mod:`.importing` (``import nastran``).
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ import sys
 from collections.abc import Sequence
 
 from .._threads import blas_limited, blas_threads
-from ..errors import InputError
-from . import analysis, importing, lco, loads, optimize, results, scenarios, sensitivity
+from ..errors import InputError, NumericalError, VerdictFailure
+from . import analysis, importing, optimize, results, scenarios, sensitivity
 
 __all__ = ["main"]
 
@@ -49,8 +51,6 @@ def _parser() -> argparse.ArgumentParser:
     )
     analysis.add_parsers(sub)
     scenarios.add_parsers(sub)
-    loads.add_parsers(sub)
-    lco.add_parsers(sub)
     results.add_parsers(sub)
     sensitivity.add_parsers(sub)
     optimize.add_parsers(sub)
@@ -150,8 +150,6 @@ def _run(args: argparse.Namespace) -> int:
     handlers = {
         **analysis.HANDLERS,
         **scenarios.HANDLERS,
-        **loads.HANDLERS,
-        **lco.HANDLERS,
         **results.HANDLERS,
         **sensitivity.HANDLERS,
         **optimize.HANDLERS,
@@ -165,17 +163,20 @@ def _run(args: argparse.Namespace) -> int:
 
     except InputError as exc:
         print(f"aeroservo: error: {exc}", file=sys.stderr)
-        return 2
+        return InputError.exit_code
+    except VerdictFailure as exc:  # the verdict's one line; the report is already printed
+        print(f"aeroservo: {' '.join(str(exc).split())}", file=sys.stderr)
+        return VerdictFailure.exit_code
     except BrokenPipeError:
         raise
     except OSError as exc:  # unwritable output folder, unreadable file
         print(f"aeroservo: error: {exc}", file=sys.stderr)
-        return 2
+        return InputError.exit_code
     except (RuntimeError, ArithmeticError, __import__("numpy").linalg.LinAlgError) as exc:
         if args.debug:
             raise
         print(f"aeroservo: numerical failure: {' '.join(str(exc).split())}", file=sys.stderr)
-        return 1
+        return NumericalError.exit_code
     except Exception as exc:  # a bug: one line, an invitation to report it
         if args.debug:
             raise

@@ -119,60 +119,24 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     check_suffix("--save", args.save, ".npz")
     check_suffix("--table", args.table, ".csv")
     s = setup(args)
-    from ..studies.flight_condition import aero_record, flutter_at_condition, mach_source
+    from ..studies.flight_condition import flutter_analysis
 
     model, wing = s.model, s.wing
     v_max = args.v_max if args.v_max is not None else s.opts.v_max
     n_modes = args.modes if args.modes is not None else s.opts.n_modes
-    kw = {"v_max": v_max, "n_modes": n_modes}
     cond = (model, s.density, s.atmosphere, s.compressibility, s.mach)
     with named("n_modes", "--modes" if args.modes is not None else None, args, "n_modes"):
-        result = flutter_at_condition(*cond, **kw)
-    source = mach_source(s.compressibility, s.mach, s.atmosphere)
-    out = {
-        "wing": wing.name,
-        "flutter_speed": result.flutter_speed,
-        "flutter_frequency": result.flutter_frequency,
-        "divergence_speed": result.divergence_speed,
-        "n_states": result.n_states,
-        "density": s.density,
-        "n_elements": model.n_elements,
-        "wagner": model.wagner.name,
-        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3", "altitude": "m"},
-        **aero_record(model, result.mach, source),
-    }
-    out.update({k: v for k, v in result.to_dict().items() if k not in out})
-    pk, sol = None, None
-    if s.sol145 is not None and s.sol145["velocities"]:
-        from ..studies.flight_condition import sol145_at_condition
-
-        pk, sol = sol145_at_condition(cond, result, s.sol145)
-        out["sol145"] = sol.to_dict()
-    elif args.pk or s.sol145 is not None:  # a deck's K or KE case: p-k over the speed range
-        from ..stability.pk import pk_flutter
-
-        kw["v_max"] = result.v_max
-        if s.atmosphere is None:
-            kw["boundary"] = result
-        pk = flutter_at_condition(*cond, solver=pk_flutter, **kw)
-    if pk is not None:
-        from ..stability.near_critical import method_discrepancy
-
-        note = method_discrepancy(result, pk, model.semichord, model.wagner.name)
-        if note and note not in pk.warnings:  # the matched (altitude) path
-            pk.warnings.append(note)
-        out["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
-            "flutter_speed": pk.flutter_speed,
-            "flutter_frequency": pk.flutter_frequency,
-            "flutter_eas": pk.flutter_eas,
-            "flutter_mach": pk.flutter_mach,
-            "divergence_speed": pk.divergence_speed,
-            "n_modes_followed": pk.info.get("n_modes"),
-            "restarted_at_onsets": pk.info.get("restarted_at_onsets", []),
-            "warnings": list(pk.warnings),
-        }
-    aero = model.wagner.name if model.dlm is None else f"doublet lattice, Mach {result.mach:.3g}"
-    title = f"{wing.name}: {model.n_elements} elements, {aero}"
+        fa = flutter_analysis(
+            model, wing.name, cond, v_max=v_max, n_modes=n_modes, pk=args.pk, sol145=s.sol145
+        )
+    result, pk, sol, out, source, title = (
+        fa.boundary,
+        fa.pk,
+        fa.sol145,
+        fa.record,
+        fa.mach_source,
+        fa.title,
+    )
     writers = []
     if args.plot:
         from ..atomic import figure_writer

@@ -328,38 +328,3 @@ def run_into_folder(scenario, args: argparse.Namespace):
         if made and out.is_dir() and not any(out.iterdir()):  # a failed run leaves nothing
             out.rmdir()
         raise
-
-
-COMMAND_OF_KIND = {"flutter": "run", "gust_loads": "loads", "lco": "lco"}
-"""The command that runs a scenario of each kind (the kind's own name otherwise)."""
-
-
-def require_kind(scenario, path: str, kind: str) -> None:
-    """An InputError naming the command for ``scenario`` unless it is of ``kind``."""
-    if scenario.kind != kind:
-        use = COMMAND_OF_KIND.get(scenario.kind, scenario.kind)
-        raise InputError(f"{path}: scenario.kind = {scenario.kind!r}: use 'aeroservo {use}' for it")
-
-
-def run_study(scenario, args: argparse.Namespace, summary) -> int:
-    """Run a loaded study scenario (gust loads, limit cycles) with the options of its command
-    (or of ``run``): ``--quick``, ``--no-plots``, the output folder, ``--json``; print
-    ``summary(run)`` and the files written."""
-    from dataclasses import replace
-
-    from ..files.summaries import json_text
-    from ..studies.scenario import quick
-
-    if args.quick:
-        scenario = quick(scenario)
-    if getattr(args, "no_plots", False):
-        scenario = replace(scenario, plots=False)
-    run, files = run_into_folder(scenario, args)
-    if args.json:
-        print(json_text(run.summary))
-        return 0
-    print(f"{scenario.name} [{scenario.kind}]")
-    print(summary(run))
-    for kind, path in files.items():
-        print(f"  wrote {kind}: {path}")
-    return 0

@@ -1,47 +1,91 @@
-"""The scenario commands: ``run``, ``simulate``, ``trade``, ``plot`` and ``examples``."""
+"""The scenario commands, made from the registry of scenario kinds
+(:data:`aeroservo.studies.kinds.KINDS`): ``run`` (any kind) and each kind's own command
+(``simulate``, ``trade``, ``loads``, ``lco``), all with the same options; and ``examples``."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ..errors import InputError
+from ..errors import InputError, VerdictFailure
 from .aero_options import add_aero_options, load_scenario_with
-from .options import positive_int, run_into_folder
+from .options import run_into_folder
 
 __all__ = ["add_parsers", "HANDLERS"]
 
 
+def _workers(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if not 0 <= v <= 256:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed range is [0, 256]")
+    return v
+
+
+DESCRIPTIONS = {
+    "loads": "Discrete tuned gusts and continuous turbulence of CS-25.341 at every flight point "
+    "of a gust_loads scenario, with and without its controller. Loads are increments of the "
+    "wing clamped at its root (1 g loads added with the airplane's mass). Writes RESULT.json, "
+    ".npz, .csv, _histories.csv, _alleviation.csv and the figures into --out (all or none); "
+    "'aeroservo plot DIR/RESULT.json' redraws them.",
+    "lco": "March a wing or a typical section with nonlinear hinges from rest with each initial "
+    "rotation at each speed of an lco scenario, and along the speeds up and down "
+    "(continuation), open loop or with its controller held fixed; judge each march (limit "
+    "cycle, decay, divergence) and compare with the describing function. Writes RESULT.json, "
+    ".csv, _branches.csv, _histories.npz, _summary.txt and the figures _bifurcation.png and "
+    "_histories.png into --out (all or none); 'aeroservo plot DIR/RESULT.json' redraws them.",
+}
+"""Longer descriptions of the scenario commands than their kind's one line."""
+
+
+def _commands() -> dict:
+    """``{command: (help, kinds)}``: ``run`` for every kind, and each kind's own command
+    (:data:`aeroservo.studies.kinds.KINDS`)."""
+    from ..studies.kinds import KINDS
+
+    names = ", ".join(KINDS)
+    out = {"run": (f"run a scenario of any kind ({names})", tuple(KINDS.values()))}
+    for k in KINDS.values():
+        if k.command != "run":
+            out[k.command] = (f"{k.description} (a scenario of kind '{k.name}')", (k,))
+    return out
+
+
 def add_parsers(sub) -> None:
-    """The scenario commands' parsers."""
-    for name, helptext in (
-        ("run", "run a scenario of any kind (flutter, simulate, trade, gust_loads, lco)"),
-        ("simulate", "run a closed-loop time simulation scenario"),
-        ("trade", "run a trade-study scenario on Dask"),
-    ):
-        r = sub.add_parser(name, help=helptext, description=helptext.capitalize() + ".")
-        r.add_argument("scenario", help="scenario file (.toml), see docs/scenarios.md")
+    """The scenario commands' parsers, one per command of the registry of kinds, with the same
+    options (those of the studies on Dask where one of its kinds is)."""
+    for name, (helptext, kinds) in _commands().items():
+        r = sub.add_parser(
+            name, help=helptext, description=DESCRIPTIONS.get(name, helptext.capitalize() + ".")
+        )
+        which = "" if len(kinds) > 1 else f", kind = '{kinds[0].name}'"
+        r.add_argument("scenario", help=f"scenario file (.toml{which}), see docs/scenarios.md")
         r.add_argument("--out", metavar="DIR", default="out", help="output folder (default out)")
         r.add_argument("--json", action="store_true", help="print the summary as JSON")
+        quick = "; ".join(f"{k.name}: {k.quick}" for k in kinds if k.quick)
         r.add_argument(
-            "--quick",
-            action="store_true",
-            help="fast settings for smoke tests (short simulation, coarse grids, 2 values per "
-            "trade parameter)",
+            "--quick", action="store_true", help=f"fast settings for smoke tests ({quick})"
         )
+        r.add_argument("--no-plots", action="store_true", help="write the data files only")
         r.add_argument(
             "--progress",
             action=argparse.BooleanOptionalAction,
             default=None,
             help="progress bars on stderr (default: when stderr is a terminal)",
         )
+        r.add_argument("--quiet", dest="progress", action="store_false", help="no progress bars")
         add_aero_options(r, mach=True)
-        if name in ("run", "trade"):
-            r.add_argument(
+        if any(k.on_dask for k in kinds):
+            where = r.add_mutually_exclusive_group()
+            where.add_argument(
                 "--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://host:port"
             )
-            r.add_argument(
-                "--workers", type=positive_int, help="LocalCluster workers (default: scenario)"
+            where.add_argument(
+                "--workers",
+                type=_workers,
+                metavar="N",
+                help="local Dask workers, 0 in this process (default: the scenario's)",
             )
 
     sub.add_parser("examples", help="list the built-in wings and the shipped scenarios")
@@ -78,44 +122,54 @@ def _cmd_examples(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    """Run a scenario (of the command's kind, or of any kind for ``run``), write its files as
+    one set and print its report (or its summary as JSON)."""
+    from dataclasses import replace
 
     from ..files.summaries import json_text
+    from ..studies.kinds import check_kind
     from ..studies.scenario import quick
 
     scenario = load_scenario_with(args.scenario, args)
-    if args.command != "run":
-        from .options import require_kind
-
-        require_kind(scenario, args.scenario, args.command)
-    if scenario.kind == "gust_loads":  # 'aeroservo run': as 'aeroservo loads' does
-        from .loads import run_loaded
-
-        return run_loaded(scenario, args)
-    if scenario.kind == "lco":  # 'aeroservo run': as 'aeroservo lco' does
-        from .lco import run_lco_loaded
-
-        return run_lco_loaded(scenario, args)
+    kinds = _commands()[args.command][1]
+    if len(kinds) == 1:
+        check_kind(scenario, kinds[0].name, args.scenario)
     if args.quick:
         scenario = quick(scenario)
-    if getattr(args, "scheduler", None) and scenario.kind != "trade":
-        raise InputError(
-            f"--scheduler = {args.scheduler!r}: only a trade study runs on a Dask cluster; "
-            f"{args.scenario} is a {scenario.kind} scenario"
-        )
-    run, _ = run_into_folder(scenario, args)
+    if args.no_plots:
+        scenario = replace(scenario, plots=False)
+    run, files = run_into_folder(scenario, args)
     summary = run.summary
     if args.json:
         print(json_text(summary))
     else:
-        print(_readable(summary))
+        print(REPORTS[scenario.kind](run, files))
     # a run's warnings are in its report (the text's "warning:" lines, the JSON's "warnings"),
     # once: stderr keeps the one line of a failed verdict
     if summary.get("passed") is False and not scenario.expect_failure:
-        from ..studies.verdict import EXIT_UNSTABLE
-
-        print(f"aeroservo: {summary['hint']}", file=sys.stderr)
-        return EXIT_UNSTABLE
+        raise VerdictFailure(summary["hint"])
     return 0
+
+
+def _study_report(run, files: dict) -> str:
+    """A study's report: its name and kind, its result's summary and the files written."""
+    lines = [f"{run.scenario.name} [{run.scenario.kind}]", run.result.summary_text()]
+    lines += [f"  wrote {kind}: {path}" for kind, path in files.items()]
+    return "\n".join(lines)
+
+
+def _summary_report(run, files: dict) -> str:
+    return _readable(run.summary)
+
+
+REPORTS = {
+    "flutter": _summary_report,
+    "simulate": _summary_report,
+    "trade": _summary_report,
+    "gust_loads": _study_report,
+    "lco": _study_report,
+}
+"""The printed report of a run of each scenario kind (:data:`aeroservo.studies.kinds.KINDS`)."""
 
 
 def _channel_text(c: dict) -> str:
@@ -311,9 +365,4 @@ def _readable(s: dict) -> str:
     return "\n".join(lines)
 
 
-HANDLERS = {
-    "examples": _cmd_examples,
-    "run": _cmd_run,
-    "simulate": _cmd_run,
-    "trade": _cmd_run,
-}
+HANDLERS = {"examples": _cmd_examples, **dict.fromkeys(_commands(), _cmd_run)}

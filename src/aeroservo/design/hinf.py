@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import InputError, check_int, check_number, check_quantity
+from ..errors import InputError, NumericalError, check_int, check_number, check_quantity
 from .compensator import DiscreteCompensator
 from .plant import SampledPlant
 
@@ -200,7 +200,7 @@ def hinf(
         out = sb10ad(*dims, w.gamma_factor * g_opt, PA, PB, PC, PD, job=4)
     except SlycotError as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise ArithmeticError(
+        raise NumericalError(
             f"H-infinity synthesis failed ({first}); try a larger hinf.order, other weights or "
             "a larger hinf.gamma_factor"
         ) from None

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from ..errors import NumericalError
+
 __all__ = ["solve_dare"]
 
 
@@ -43,5 +45,5 @@ def solve_dare(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np
     res = axa - corr + Q0 - Xb
     scale = np.linalg.norm(axa) + np.linalg.norm(corr) + np.linalg.norm(Q0) + np.linalg.norm(Xb)
     if not np.linalg.norm(res) <= 1e-8 * scale:
-        raise ArithmeticError("discrete Riccati equation: the doubling iteration did not converge")
+        raise NumericalError("discrete Riccati equation: the doubling iteration did not converge")
     return Xb / t[:, None] / t[None, :]

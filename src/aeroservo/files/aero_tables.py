@@ -111,9 +111,10 @@ def aero_options(
     return settings, mach
 
 
-def model_aero(md: Table, kw: dict, kind: str, section: bool) -> None:
+def model_aero(md: Table, kw: dict, fixed_mach: bool, section: bool) -> None:
     """``model.aero``, ``model.mach`` and ``[model.dlm]`` of a scenario into ``kw`` (``aero``:
-    DoubletLattice or None, ``mach``: float or None)."""
+    DoubletLattice or None, ``mach``: float or None); ``fixed_mach``: whether the scenario's
+    kind takes a fixed Mach number, ``section``: whether it describes a typical section."""
     if not (md.has("aero") or md.has("mach") or md.has("dlm")):
         return
     try:
@@ -129,7 +130,7 @@ def model_aero(md: Table, kw: dict, kind: str, section: bool) -> None:
             "the typical section ([section]) has strip aerodynamics only; give a [wing] for "
             "the doublet lattice",
         )
-    if mach is not None and kind != "flutter":
+    if mach is not None and not fixed_mach:
         md.fail(
             "mach",
             mach,

@@ -13,6 +13,7 @@ from ..aero.gust_rules import U_REF_TABLE, Z_REF
 from ..errors import InputError
 from ..studies.gust_loads import SPEED_NAMES, FlightPoint
 from ..studies.scenario import Scenario
+from ..studies.study_options import GustLoadsOptions
 from .scenario_tables import controller, is_file
 from .toml_tables import Table
 
@@ -66,8 +67,7 @@ def gust_loads_tables(top: Table, base: Path, kw: dict) -> None:
         top.table("controller").fail(
             "design_mass_case", design_case, f"not a mass case; they are {list(g['mass_cases'])}"
         )
-    g["design_mass_case"] = design_case
-    kw["gust_loads"] = g
+    kw["options"] = GustLoadsOptions(**g, design_mass_case=design_case)
 
 
 def gust_loads_table(gl: Table, base: Path, wing) -> dict:
@@ -208,7 +208,7 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
     spec = s.controller if s.controller is not None and s.controller.type != "none" else None
     if s.aero is not None and s.aero != "strip":
         for key in ("stations", "aircraft_mass"):
-            if g[key]:
+            if getattr(g, key):
                 gl.fail(
                     key,
                     gl.data.get(key, "(a mass case's)"),
@@ -216,20 +216,20 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
                     "(loads along the span and the wing's weight); the doublet lattice "
                     "gives root loads only",
                 )
-    for case, wing in g["mass_cases"].items():
+    for case, wing in g.mass_cases.items():
         where = "" if case == NOMINAL else f" (mass case {case!r})"
         aero = "strip" if s.aero is None else s.aero
-        for x in g["stations"]:
+        for x in g.stations:
             if x > wing.span:
                 gl.fail(
                     "stations",
-                    list(g["stations"]),
+                    list(g.stations),
                     f"{x:g} m is beyond the span {wing.span:g} m of mass case {case!r}",
                 )
         model = AeroelasticModel(
-            wing, s.elements, s.wagner, damping=s.damping, aero=aero, load_stations=g["stations"]
+            wing, s.elements, s.wagner, damping=s.damping, aero=aero, load_stations=g.stations
         )
-        for i, name in enumerate(g["loads"]):
+        for i, name in enumerate(g.loads):
             try:
                 resolve_outputs(model, [name], model.n_dofs)
             except InputError as exc:
@@ -248,6 +248,6 @@ def gust_cross_check(s: Scenario, top: Table) -> None:
             "simulation.sample_rate",
         )
     try:
-        check_spec_signals(spec, s.controls, s.sensors, tuple(g["loads"]) + tuple(s.outputs))
+        check_spec_signals(spec, s.controls, s.sensors, tuple(g.loads) + tuple(s.outputs))
     except InputError as exc:
         raise InputError(f"{s.source}: controller.spec -> {exc}") from None

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from ..simulate.hinge_march import MAX_HINGE_SAMPLES
 from ..studies.scenario import Scenario
+from ..studies.study_options import LCOOptions
 from .hinge_tables import check_targets, hinges_from_list
 from .scenario_tables import controller
 from .toml_tables import Table
@@ -158,7 +159,7 @@ def lco_tables(top: Table, base: Path, kw: dict) -> None:
             if tbl.has(key):
                 tbl.fail(key, tbl.data[key], f"{only} ({why})")
     lt = top.table("lco", required=True)
-    kw["lco"] = lco_table(lt, kw, closed=closed)
+    kw["options"] = LCOOptions(**lco_table(lt, kw, closed=closed))
 
 
 def lco_table(lt: Table, kw: dict, closed: bool) -> dict:
@@ -249,25 +250,25 @@ def lco_cross_check(s: Scenario, top: Table) -> None:
     from .scenario_checks import check_loop_signals
 
     lco = s.lco
-    where = lco["hinges_source"]
+    where = lco.hinges_source
     key = "lco.hinges" if where == "lco.hinges" else "hinges"
     file = top.file if key == "lco.hinges" else f"{top.file}: wing.file -> {s.wing_source}"
     if s.section is not None:  # a [section] table always has a flap (hinge is required)
-        for i, h in enumerate(lco["hinges"]):
+        for i, h in enumerate(lco.hinges):
             if h.target != "flap":
                 raise InputError(
                     f"{file}: {key}[{i}].target = {h.target!r}: a typical section has one "
                     "nonlinear hinge, target 'flap'"
                 )
-        if len(lco["hinges"]) > 1:
+        if len(lco.hinges) > 1:
             raise InputError(f"{file}: {key}[1]: a typical section has one nonlinear hinge")
         return
-    check_targets(lco["hinges"], s.wing, file, key)
+    check_targets(lco.hinges, s.wing, file, key)
     if s.controller is None or s.controller.type == "none":
         return
     surfaces = {cs.name: [a.name for a in cs.actuators] for cs in s.wing.control_surfaces}
     actuators = {a for acts in surfaces.values() for a in acts}
-    for i, h in enumerate(lco["hinges"]):  # as check_targets resolves them
+    for i, h in enumerate(lco.hinges):  # as check_targets resolves them
         for a in [h.target] if h.target in actuators else surfaces[h.target]:
             if f"{a}_nonlinear_moment" in s.controls:
                 top.table("signals").fail(

@@ -55,87 +55,118 @@ def write_run(run: Run, out_dir: str | Path) -> dict[str, str]:
 
 def _write_run(run: Run, out: Path) -> dict[str, str]:
     """:func:`write_run` into the folder ``out``."""
-    sc = run.scenario
-    summary = run.summary
-    items: list = []
     files: dict[str, str] = {}
-    plots = sc.plots
+    items: list = []
 
     def add(kind: str, path: Path, writer) -> None:
         files[kind] = str(path)
         items.append((path, writer))
 
-    if sc.kind == "flutter":
-        json_path = out / f"{sc.result}.json"
-        files["summary"] = str(json_path)
-        if plots:
-            from ..plots import plot_vg
-
-            png = out / f"{sc.result}_vg.png"
-            add("vg_plot", png, figure_writer(plot_vg(run.flutter, title=run.title), png, dpi=120))
-    elif sc.kind == "simulate":
-        npz = out / f"{sc.result}.npz"
-        add("result", npz, result_writer(run.simulation, dict(summary)))
-        if plots:
-            png = out / f"{sc.result}.png"
-            fig = run.simulation.plot(open_loop=run.open_loop)
-            add("plot", png, figure_writer(fig, png, dpi=120))
-            judged = getattr(run.judgement, "boundary", None)
-            boundary = run.boundary if run.boundary is not None else judged
-            if boundary is not None:
-                png = out / f"{sc.result}_boundary.png"
-                e = run.judgement.engaged
-                fig = boundary.plot(
-                    open_loop=run.flutter, engaged=(e.low, e.high), stable_to=e.stable_to
-                )
-                fig.axes[0].set_title(
-                    f"{sc.name}\nengaged {e.text()} (shaded), stability required to "
-                    f"{e.stable_to:.4g} m/s (dotted)",
-                    fontsize=9,
-                )
-                add("boundary_plot", png, figure_writer(fig, png, dpi=120))
-            if run.margins is not None:
-                from ..plots import plot_loop_margins, plot_margin_sweep
-
-                png = out / f"{sc.result}_margins.png"
-                fig = plot_loop_margins(run.margins, title=sc.name)
-                add("margins_plot", png, figure_writer(fig, png, dpi=120))
-                if run.margin_sweep is not None:
-                    png = out / f"{sc.result}_margin_sweep.png"
-                    fig = plot_margin_sweep(run.margin_sweep, title=sc.name)
-                    add("margin_sweep_plot", png, figure_writer(fig, png, dpi=120))
-
-        json_path = out / f"{sc.result}.json"
-        files["summary"] = str(json_path)
-    elif sc.kind in ("gust_loads", "lco"):
-        from ..studies.gust_scenario import gust_figures
-        from ..studies.lco_scenario import lco_figures
-        from .gust_loads_file import gust_loads_items
-        from .lco_file import lco_items
-
-        gust = sc.kind == "gust_loads"
-        res, items_of, figures = (
-            (run.loads, gust_loads_items, gust_figures)
-            if gust
-            else (run.lco, lco_items, lco_figures)
-        )
-        data = items_of(res, out / f"{sc.result}.json", summary)
-        for kind, (path, writer) in data.items():
-            add(kind, path, writer)  # the JSON's text is made when written, files included
-        for name, fig in figures(res).items() if plots else ():
-            png = out / f"{sc.result}_{name}.png"
-            add(f"{name}_plot", png, figure_writer(fig, png, dpi=120))
-        summary["files"] = files
-        atomic_write_set(items)
-        return files
-    else:
-        res, folder = run.trade, run.folder
-        files["csv"], files["netcdf"] = str(res.csv_path), str(res.netcdf_path)
-        for name, fig in res.figures().items() if plots else ():
-            png = folder / name
-            add(png.stem, png, figure_writer(fig, png, dpi=120))
-        json_path = folder / "summary.json"
-    summary["files"] = files
-    items.append((json_path, _text_writer(json_text(summary))))
+    summary_path = WRITERS[run.scenario.kind](run, out, add, files)
+    run.summary["files"] = files
+    if summary_path is not None:
+        items.append((summary_path, _text_writer(json_text(run.summary))))
     atomic_write_set(items)
     return files
+
+
+def _figure(add, name: str, png: Path, fig) -> None:
+    add(name, png, figure_writer(fig, png, dpi=120))
+
+
+def _flutter_files(run: Run, out: Path, add, files: dict) -> Path:
+    """A flutter run's V-g figure; its summary is ``<result>.json``."""
+    sc = run.scenario
+    files["summary"] = str(out / f"{sc.result}.json")
+    if sc.plots:
+        from ..plots import plot_vg
+
+        _figure(add, "vg_plot", out / f"{sc.result}_vg.png", plot_vg(run.flutter, title=run.title))
+    return out / f"{sc.result}.json"
+
+
+def _simulation_files(run: Run, out: Path, add, files: dict) -> Path:
+    """A simulation's NPZ and figures: time histories, the closed-loop boundary, the margins
+    and their sweep; its summary is ``<result>.json``."""
+    sc = run.scenario
+    npz = out / f"{sc.result}.npz"
+    add("result", npz, result_writer(run.simulation, dict(run.summary)))
+    if sc.plots:
+        fig = run.simulation.plot(open_loop=run.open_loop)
+        _figure(add, "plot", out / f"{sc.result}.png", fig)
+        judged = getattr(run.judgement, "boundary", None)
+        boundary = run.boundary if run.boundary is not None else judged
+        if boundary is not None:
+            e = run.judgement.engaged
+            fig = boundary.plot(
+                open_loop=run.flutter, engaged=(e.low, e.high), stable_to=e.stable_to
+            )
+            fig.axes[0].set_title(
+                f"{sc.name}\nengaged {e.text()} (shaded), stability required to "
+                f"{e.stable_to:.4g} m/s (dotted)",
+                fontsize=9,
+            )
+            _figure(add, "boundary_plot", out / f"{sc.result}_boundary.png", fig)
+        if run.margins is not None:
+            from ..plots import plot_loop_margins, plot_margin_sweep
+
+            fig = plot_loop_margins(run.margins, title=sc.name)
+            _figure(add, "margins_plot", out / f"{sc.result}_margins.png", fig)
+            if run.margin_sweep is not None:
+                fig = plot_margin_sweep(run.margin_sweep, title=sc.name)
+                _figure(add, "margin_sweep_plot", out / f"{sc.result}_margin_sweep.png", fig)
+    files["summary"] = str(out / f"{sc.result}.json")
+    return out / f"{sc.result}.json"
+
+
+def _study_files(items_of, figures):
+    """The writer of a study whose JSON holds its summary and records (gust loads, limit
+    cycles): ``items_of(result, json_path, summary)`` gives its data files, ``figures(result)``
+    its figures by file suffix."""
+
+    def write(run: Run, out: Path, add, files: dict) -> None:
+        sc = run.scenario
+        data = items_of(run.result, out / f"{sc.result}.json", run.summary)
+        for kind, (path, writer) in data.items():
+            add(kind, path, writer)  # the JSON's text is made when written, files included
+        for name, fig in figures(run.result).items() if sc.plots else ():
+            _figure(add, f"{name}_plot", out / f"{sc.result}_{name}.png", fig)
+
+    return write
+
+
+def _gust_loads_files(run: Run, out: Path, add, files: dict) -> None:
+    from ..studies.gust_scenario import gust_figures
+    from .gust_loads_file import gust_loads_items
+
+    return _study_files(gust_loads_items, gust_figures)(run, out, add, files)
+
+
+def _lco_files(run: Run, out: Path, add, files: dict) -> None:
+    from ..studies.lco_scenario import lco_figures
+    from .lco_file import lco_items
+
+    return _study_files(lco_items, lco_figures)(run, out, add, files)
+
+
+def _trade_files(run: Run, out: Path, add, files: dict) -> Path:
+    """A trade study's figures into its folder (its cases, CSV and NetCDF are written as they
+    come); its summary is ``<result>/summary.json``."""
+    res, folder = run.trade, run.folder
+    files["csv"], files["netcdf"] = str(res.csv_path), str(res.netcdf_path)
+    for name, fig in res.figures().items() if run.scenario.plots else ():
+        png = folder / name
+        _figure(add, png.stem, png, fig)
+    return folder / "summary.json"
+
+
+WRITERS = {
+    "flutter": _flutter_files,
+    "simulate": _simulation_files,
+    "trade": _trade_files,
+    "gust_loads": _gust_loads_files,
+    "lco": _lco_files,
+}
+"""Per scenario kind (:data:`aeroservo.studies.kinds.KINDS`): ``f(run, out, add, files)``
+adds the run's files (``add(kind, path, writer)``) and returns the path of its JSON summary
+(None: one of its data files holds it)."""

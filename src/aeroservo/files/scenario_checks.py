@@ -1,8 +1,8 @@
 """Checks of a scenario that need its wing: signal names, sensor stations, the controller
 file's signals, the trade study against the wing, limits against the initial state.
 
-Every error names the scenario file, the key and the value (:func:`cross_check` is called by
-:func:`aeroservo.files.scenario_file.scenario_from_dict`).
+Every error names the scenario file, the key and the value (the checks of each kind are
+called by :func:`aeroservo.files.scenario_file.scenario_from_dict`).
 """
 
 from __future__ import annotations
@@ -13,12 +13,12 @@ from ..errors import InputError
 from ..studies.scenario import Scenario
 from .toml_tables import Table
 
-__all__ = ["cross_check"]
+__all__ = ["simulate_check", "trade_check", "check_loop_signals"]
 
 
 def _check_study(s: Scenario) -> None:
     """Validate a trade scenario's study (parameters against the wing, ...)."""
-    from ..studies.runs import study_from_scenario
+    from ..studies.trade.scenario import study_from_scenario
 
     try:
         study_from_scenario(s)
@@ -56,15 +56,12 @@ def check_loop_signals(s: Scenario, wing, model, top: Table, where: str = "") ->
                 sg.fail(key, names, f"{exc}{where}")
 
 
-def cross_check(s: Scenario, top: Table) -> None:
-    """Checks that need the wing: signal names, stations, limits against the initial state."""
+def _loop_check(s: Scenario, top: Table, spec, key: str) -> object:
+    """The loop's signals on the wing, the sensor filter against the sample rate and the
+    controller's signal names against the loop's (``key`` names the controller in errors);
+    returns the wing's model."""
     from ..design.loop import check_spec_signals
 
-    if s.kind == "flutter":
-        return
-    if s.kind == "trade" and not s.trade["closed_loop"]:  # no loop: the study's checks only
-        _check_study(s)
-        return
     sg = top.table("signals")
     model = s.model()
     check_loop_signals(s, s.wing, model, top)
@@ -77,15 +74,26 @@ def cross_check(s: Scenario, top: Table) -> None:
         )
     # the controller's signal names against the loop's, without building the loop's
     # state-space models (that takes minutes for a fine mesh)
-    key = "trade.controller" if s.kind == "trade" else "controller.spec"
-    spec = s.trade["controller"] if s.kind == "trade" else s.controller
     try:
         check_spec_signals(spec, s.controls, s.sensors, s.outputs)
     except InputError as exc:
         raise InputError(f"{s.source}: {key} -> {exc}") from None
-    if s.kind == "trade":
-        _check_study(s)
-        return
+    return model
+
+
+def trade_check(s: Scenario, top: Table) -> None:
+    """Checks of a trade scenario that need the wing: the loop's signals (closed loop) and the
+    study against the wing (its parameters, ...)."""
+    if s.trade.closed_loop:
+        _loop_check(s, top, s.trade.controller, "trade.controller")
+    _check_study(s)
+
+
+def simulate_check(s: Scenario, top: Table) -> None:
+    """Checks of a simulation scenario that need the wing: signal names, sensor noise, limits
+    against the initial state."""
+    spec = s.controller
+    model = _loop_check(s, top, spec, "controller.spec")
     for name in s.sensor_noise:
         if name not in s.sensors:
             top.table("simulation").table("sensor_noise").fail(

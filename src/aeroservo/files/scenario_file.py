@@ -18,11 +18,12 @@ from pathlib import Path
 from ..errors import MAX_ELEMENTS, InputError
 from ..simulate.march import MAX_SAMPLES
 from ..stability.matched import COMPRESSIBILITY
-from ..studies.scenario import SCENARIO_KINDS, Scenario
+from ..studies.kinds import KINDS
+from ..studies.scenario import Scenario
 from .aero_tables import model_aero
 from .gust_loads_tables import gust_cross_check, gust_loads_tables
 from .lco_tables import lco_cross_check, lco_tables, section_table
-from .scenario_checks import cross_check
+from .scenario_checks import simulate_check, trade_check
 from .scenario_tables import (
     actuator_table,
     controller,
@@ -57,48 +58,6 @@ TOP = (
     "section",
     "sol145",
 )
-USED = {
-    "flutter": ("scenario", "wing", "flight", "model", "analysis", "output", "damping", "sol145"),
-    "simulate": TOP[: TOP.index("trade")],
-    "trade": (
-        "scenario",
-        "wing",
-        "flight",
-        "model",
-        "signals",
-        "actuator",
-        "simulation",
-        "output",
-        "damping",
-        "trade",
-    ),
-    "gust_loads": (
-        "scenario",
-        "wing",
-        "flight",
-        "model",
-        "signals",
-        "actuator",
-        "controller",
-        "simulation",
-        "output",
-        "damping",
-        "gust_loads",
-    ),
-    "lco": (
-        "scenario",
-        "wing",
-        "section",
-        "flight",
-        "model",
-        "signals",
-        "controller",
-        "simulation",
-        "output",
-        "damping",
-        "lco",
-    ),
-}
 
 
 def _surface_keys(message: str, data: object, where: str) -> str:
@@ -166,13 +125,14 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     check_integers(data, file)
     top = Table(data, "", file).check_keys(("scenario",), TOP[1:])
     sc = top.table("scenario").check_keys(("name", "kind"), ("description",))
-    kind = sc.string("kind", choices=SCENARIO_KINDS, required=True)
+    kind = sc.string("kind", choices=tuple(KINDS), required=True)
+    this = KINDS[kind]
     for key in TOP:
-        if top.has(key) and key not in USED[kind]:
+        if top.has(key) and key not in this.tables:
             top.fail(key, top.data[key], f"not used by a scenario of kind {kind!r}")
-    section = kind == "lco" and top.has("section")  # a typical section instead of a wing
+    section = this.section and top.has("section")  # a typical section instead of a wing
     if not section and not top.has("wing"):
-        also = " (or [section], a typical section)" if kind == "lco" else ""
+        also = " (or [section], a typical section)" if this.section else ""
         raise InputError(f"{file}: wing: missing required key{also}")
     kw: dict = {
         "name": sc.string("name", required=True),
@@ -189,13 +149,13 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     fl = top.table("flight").check_keys(
         (), ("density", "altitude", "altitude_ft", "speed", "speed_factor")
     )
-    if fl.data or kind != "gust_loads":  # gust loads: the controller's design point
+    if fl.data or not this.flight_is_design_point:  # else: the controller's design point
         flight(fl, kw)
     if fl.has("speed") and fl.has("speed_factor"):
         fl.fail("speed_factor", fl.data["speed_factor"], "give speed or speed_factor, not both")
     kw["speed"] = fl.number("speed", quantity="flight_speed")
     kw["speed_factor"] = fl.number("speed_factor", quantity="speed_factor")
-    if kind == "simulate" and kw["speed"] is None and kw["speed_factor"] is None:
+    if this.needs_speed and kw["speed"] is None and kw["speed_factor"] is None:
         raise InputError(f"{file}: flight.speed: missing; give speed [m/s] or speed_factor")
 
     md = top.table("model").check_keys(
@@ -205,7 +165,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
     )
     comp = md.string("compressibility", "none", choices=COMPRESSIBILITY)
     if comp != "none":
-        if kind != "flutter":
+        if not this.flight_condition:
             md.fail(
                 "compressibility",
                 comp,
@@ -214,7 +174,7 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         if kw["altitude"] is None:
             md.fail("compressibility", comp, "needs flight.altitude or flight.altitude_ft")
         kw["compressibility"] = comp
-    model_aero(md, kw, kind, section)
+    model_aero(md, kw, this.flight_condition, section)
     if top.has("damping"):
         try:
             kw["damping"] = damping_from_dict(top.data["damping"], "damping")
@@ -307,30 +267,53 @@ def _scenario_from_dict(data: object, file: str, base: Path | None) -> Scenario:
         )
     kw["plots"] = out.boolean("plots", True)
 
-    if kind == "simulate":
-        kw["disturbance"] = disturbance(top.table("disturbance"), base, wing.span)
-        ct = top.table("controller", required=True).check_keys(
-            ("spec",),
-            ("engaged_speeds", "engaged_speed_factors", "flutter_margin", "realisable"),
-        )
-        kw["realisable"] = ct.boolean("realisable", False)
-        spec_path = ct.path("spec", base, required=True)
-        kw["controller"] = controller(ct, spec_path)
-        engaged_speeds(ct, kw)
-        kw["flutter_margin"] = ct.number("flutter_margin", 1.15, lo=1.0, hi=3.0)
-    if kind == "trade":
-        kw["trade"] = trade_table(top.table("trade", required=True), base)
-    if kind == "gust_loads":
-        gust_loads_tables(top, base, kw)
-    if section:
-        section_table(top, kw)
-    if kind == "lco":
-        lco_tables(top, base, kw)
-
+    tables, check = KIND_TABLES[kind]
+    tables(top, base, kw)
     scenario = Scenario(**kw)
-    checks = {"gust_loads": gust_cross_check, "lco": lco_cross_check}
-    checks.get(kind, cross_check)(scenario, top)
+    check(scenario, top)
     return scenario
+
+
+def _simulate_tables(top: Table, base: Path, kw: dict) -> None:
+    """``[disturbance]`` and ``[controller]`` of a simulation scenario into ``kw``."""
+    kw["disturbance"] = disturbance(top.table("disturbance"), base, kw["wing"].span)
+    ct = top.table("controller", required=True).check_keys(
+        ("spec",),
+        ("engaged_speeds", "engaged_speed_factors", "flutter_margin", "realisable"),
+    )
+    kw["realisable"] = ct.boolean("realisable", False)
+    spec_path = ct.path("spec", base, required=True)
+    kw["controller"] = controller(ct, spec_path)
+    engaged_speeds(ct, kw)
+    kw["flutter_margin"] = ct.number("flutter_margin", 1.15, lo=1.0, hi=3.0)
+
+
+def _trade_tables(top: Table, base: Path, kw: dict) -> None:
+    """``[trade]`` of a trade scenario into ``kw``."""
+    kw["options"] = trade_table(top.table("trade", required=True), base)
+
+
+def _lco_tables(top: Table, base: Path, kw: dict) -> None:
+    """``[section]`` (a typical section instead of a wing) and ``[lco]`` into ``kw``."""
+    if kw["wing"] is None:
+        section_table(top, kw)
+    lco_tables(top, base, kw)
+
+
+def _none(*_args) -> None:
+    """No tables of its own, no checks that need the wing."""
+
+
+KIND_TABLES: dict = {
+    "flutter": (_none, _none),
+    "simulate": (_simulate_tables, simulate_check),
+    "trade": (_trade_tables, trade_check),
+    "gust_loads": (gust_loads_tables, gust_cross_check),
+    "lco": (_lco_tables, lco_cross_check),
+}
+"""Per scenario kind (:data:`aeroservo.studies.kinds.KINDS`): the reader of its own tables
+into the :class:`~aeroservo.studies.scenario.Scenario` keywords, and its checks that need the
+wing."""
 
 
 def load_scenario(path: str | Path, model: dict | None = None) -> Scenario:

@@ -13,6 +13,7 @@ from ..aero.atmosphere import ALTITUDE_RANGE, FT, isa
 from ..design.spec import ControllerSpec
 from ..errors import NUMBER, InputError
 from ..studies.scenario import GUST_KEYS, GUST_TYPES, Disturbance
+from ..studies.study_options import TradeOptions
 from .controller_file import load_controller
 from .toml_tables import Table
 from .user_files import read_text
@@ -138,7 +139,7 @@ def flight(fl: Table, kw: dict) -> None:
         kw["altitude"], kw["density"] = atm.altitude, atm.density
 
 
-def trade_table(tbl: Table, base: Path) -> dict:
+def trade_table(tbl: Table, base: Path) -> TradeOptions:
     """Raw trade settings; validated against the wing by :mod:`aeroservo.studies.trade`.
     ``closed_loop = false``: the open-loop flutter boundary of each case only (no controller);
     ``masses[i].<key>`` parameters sweep the wing's concentrated masses."""
@@ -187,18 +188,18 @@ def trade_table(tbl: Table, base: Path) -> dict:
     n_cases = int(np.prod([len(v) for v in params.values()]))
     if n_cases > 1_000_000:
         tbl.fail("parameters", tbl.data["parameters"], f"{n_cases} cases: the limit is 1 000 000")
-    return {
-        "closed_loop": closed_loop,
-        "controller": spec,
-        "parameters": params,
-        "speed_factor": tbl.number("speed_factor", 1.1, quantity="speed_factor"),
-        "gust_length": tbl.number("gust_length", 25.0, quantity="gust_length"),
-        "gust_amplitude": tbl.number("gust_amplitude", 5.0, quantity="gust_velocity"),
-        "gust_duration": tbl.number("gust_duration", 1.0, unit="s", lo=0.0, hi=60.0, lo_open=True),
-        "v_max_factor": tbl.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True),
-        "n_grid": tbl.integer("n_grid", 21, lo=3, hi=2000),
-        "workers": tbl.integer("workers", 2, lo=1, hi=256),
-    }
+    return TradeOptions(
+        closed_loop=closed_loop,
+        controller=spec,
+        parameters=params,
+        speed_factor=tbl.number("speed_factor", 1.1, quantity="speed_factor"),
+        gust_length=tbl.number("gust_length", 25.0, quantity="gust_length"),
+        gust_amplitude=tbl.number("gust_amplitude", 5.0, quantity="gust_velocity"),
+        gust_duration=tbl.number("gust_duration", 1.0, unit="s", lo=0.0, hi=60.0, lo_open=True),
+        v_max_factor=tbl.number("v_max_factor", 2.0, lo=1.0, hi=10.0, lo_open=True),
+        n_grid=tbl.integer("n_grid", 21, lo=3, hi=2000),
+        workers=tbl.integer("workers", 2, lo=1, hi=256),
+    )
 
 
 def is_file(path: Path) -> bool:

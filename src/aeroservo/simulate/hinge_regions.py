@@ -18,7 +18,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..design.plant import zoh
-from ..errors import InputError
+from ..errors import NumericalError
 from .hinge_path import (
     FINE,
     GRID,
@@ -122,7 +122,7 @@ class Regions:
                 np.abs(A).sum(axis=1).max() * np.abs(z).max(), 1.0
             )
             if not err < 1e-8:
-                raise InputError(
+                raise NumericalError(
                     f"nonlinear march: the linear system of region {r} is defective (eigen-"
                     f"decomposition residual {err:.1e}); it cannot be marched exactly"
                 )
@@ -195,4 +195,4 @@ class Regions:
             r = r[:e] + (r[e] + (1 if upper else -1),) + r[e + 1 :]
             if t >= h * (1.0 - 1e-14):
                 return x, r
-        raise InputError("nonlinear march: more than 10000 switches in one sample (chattering)")
+        raise NumericalError("nonlinear march: more than 10000 switches in one sample (chattering)")

@@ -5,10 +5,19 @@ a model's aerodynamics (strip theory or the doublet lattice at its Mach number) 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from ..errors import InputError
 
-__all__ = ["flutter_at_condition", "aero_record", "aero_text", "mach_source"]
+__all__ = [
+    "flutter_at_condition",
+    "flutter_analysis",
+    "FlutterAnalysis",
+    "aero_record",
+    "aero_text",
+    "mach_source",
+    "sol145_at_condition",
+]
 
 
 def flutter_at_condition(
@@ -136,3 +145,117 @@ def sol145_at_condition(cond: tuple, boundary, sol145: dict):
         velocity_factor=sol145["velocity_factor"],
     )
     return pk, summary
+
+
+@dataclass
+class FlutterAnalysis:
+    """Flutter at a flight condition as a file or the command line gives it: the time-domain
+    boundary, the p-k check when asked (or the Nastran case's velocities), and their record.
+
+    Attributes
+    ----------
+    boundary : FlutterResult
+        The time-domain boundary (the eigenvalues of the first-order system).
+    pk : FlutterResult or None
+        The p-k boundary (exact Theodorsen, or the doublet lattice's tabulated forces).
+    sol145 : Sol145Summary or None
+        The Nastran flutter summary at the deck's velocities.
+    record : dict
+        JSON-ready: speeds [m/s], frequencies [Hz], the model and aerodynamics, the boundary's
+        own record, ``sol145`` and the p-k's (``pk_exact_theodorsen`` or
+        ``pk_doublet_lattice``).
+    mach_source : str
+        How the Mach number was chosen (:func:`mach_source`).
+    title : str
+        The figure title: the wing, its elements and aerodynamics.
+    """
+
+    boundary: object
+    pk: object
+    sol145: object
+    record: dict
+    mach_source: str
+    title: str
+
+
+def flutter_analysis(
+    model,
+    wing_name: str,
+    cond: tuple,
+    *,
+    v_max: float | None = None,
+    n_modes: int | None = None,
+    pk: bool = False,
+    sol145: dict | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> FlutterAnalysis:
+    """Flutter and divergence of ``model`` at a flight condition, with the p-k check.
+
+    Parameters
+    ----------
+    model : AeroelasticModel
+    wing_name : str
+        The wing's name (in the record and the title).
+    cond : tuple
+        ``(model, density, atmosphere, compressibility, mach)`` as for
+        :func:`flutter_at_condition`.
+    v_max : float, optional
+        Top of the searched speed range [m/s].
+    n_modes : int, optional
+        Modes of the modal model (None: the mode rule).
+    pk : bool
+        Also the p-k boundary over the speed range.
+    sol145 : dict, optional
+        A Nastran flutter case (a scenario's ``[sol145]``): with velocities, the p-k there and
+        its flutter summary; without (a K or KE case), the p-k over the speed range.
+    progress : callable, optional
+        Called with the speed reached [m/s] (the density path only).
+    """
+    from ..stability.near_critical import method_discrepancy
+
+    _, density, atmosphere, compressibility, mach = cond
+    kw: dict = {"v_max": v_max, "n_modes": n_modes}
+    extra = {"progress": progress} if progress is not None and atmosphere is None else {}
+    result = flutter_at_condition(*cond, **kw, **extra)
+    source = mach_source(compressibility, mach, atmosphere)
+    record = {
+        "wing": wing_name,
+        "flutter_speed": result.flutter_speed,
+        "flutter_frequency": result.flutter_frequency,
+        "divergence_speed": result.divergence_speed,
+        "n_states": result.n_states,
+        "density": density,
+        "n_elements": model.n_elements,
+        "wagner": model.wagner.name,
+        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3", "altitude": "m"},
+        **aero_record(model, result.mach, source),
+    }
+    record.update({k: v for k, v in result.to_dict().items() if k not in record})
+    pk_result, sol = None, None
+    if sol145 is not None and sol145["velocities"]:
+        pk_result, sol = sol145_at_condition(cond, result, sol145)
+        record["sol145"] = sol.to_dict()
+    elif pk or sol145 is not None:  # a deck's K or KE case: p-k over the speed range
+        from ..stability.pk import pk_flutter
+
+        kw["v_max"] = result.v_max
+        if atmosphere is None:
+            kw["boundary"] = result
+        pk_result = flutter_at_condition(*cond, solver=pk_flutter, **kw)
+    if pk_result is not None:
+        note = method_discrepancy(result, pk_result, model.semichord, model.wagner.name)
+        if note and note not in pk_result.warnings:  # the matched (altitude) path
+            pk_result.warnings.append(note)
+        record["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
+            "flutter_speed": pk_result.flutter_speed,
+            "flutter_frequency": pk_result.flutter_frequency,
+            "flutter_eas": pk_result.flutter_eas,
+            "flutter_mach": pk_result.flutter_mach,
+            "divergence_speed": pk_result.divergence_speed,
+            "n_modes_followed": pk_result.info.get("n_modes"),
+            "restarted_at_onsets": pk_result.info.get("restarted_at_onsets", []),
+            "warnings": list(pk_result.warnings),
+        }
+    aero = model.wagner.name if model.dlm is None else f"doublet lattice, Mach {result.mach:.3g}"
+    title = f"{wing_name}: {model.n_elements} elements, {aero}"
+    return FlutterAnalysis(result, pk_result, sol, record, source, title)

@@ -14,6 +14,7 @@ import math
 
 from ..errors import InputError
 from .gust_results import _point_label as _label
+from .kinds import Run, check_kind
 from .scenario import Scenario
 
 __all__ = [
@@ -33,32 +34,31 @@ def gust_study(scenario: Scenario):
     (a controller file of type ``none`` is no controller: open loop only)."""
     from .gust_loads import GustLoadsStudy
 
-    if scenario.kind != "gust_loads" or scenario.gust_loads is None:
-        raise InputError(f"{scenario.source}: scenario.kind = {scenario.kind!r}: not 'gust_loads'")
+    check_kind(scenario, "gust_loads")
     g = scenario.gust_loads
     ctrl = scenario.controller
     if ctrl is not None and getattr(ctrl, "type", "") == "none":
         ctrl = None
     loop = ctrl is not None
     return GustLoadsStudy(
-        mass_cases=dict(g["mass_cases"]),
-        points=tuple(g["points"]),
-        loads=tuple(g["loads"]),
-        load_stations=tuple(g["stations"]),
-        v_c=g.get("v_c"),
-        v_d=g.get("v_d"),
-        aircraft_mass=dict(g.get("aircraft_mass", {})),
-        lift_share=g.get("lift_share", 0.5),
+        mass_cases=dict(g.mass_cases),
+        points=tuple(g.points),
+        loads=tuple(g.loads),
+        load_stations=tuple(g.stations),
+        v_c=g.v_c,
+        v_d=g.v_d,
+        aircraft_mass=dict(g.aircraft_mass),
+        lift_share=g.lift_share,
         controls=tuple(scenario.controls) if loop else (),
         sensors=tuple(scenario.sensors) if loop else (),
         outputs=tuple(scenario.outputs) if loop else (),
         controller=ctrl,
-        design_mass_case=g.get("design_mass_case", ""),
+        design_mass_case=g.design_mass_case,
         design_density=scenario.density,
         design_speed=scenario.speed,
         design_speed_factor=scenario.speed_factor,
-        f_g=g["f_g"],
-        weights=dict(g["weights"]),
+        f_g=g.f_g,
+        weights=dict(g.weights),
         elements=scenario.elements,
         wagner=scenario.wagner,
         damping=scenario.damping,
@@ -69,8 +69,8 @@ def gust_study(scenario: Scenario):
         sample_rate=scenario.sample_rate,
         delay=scenario.delay,
         actuator=scenario.actuator if loop else None,
-        n_gradients=g["n_gradients"],
-        turbulence=g["turbulence"],
+        n_gradients=g.n_gradients,
+        turbulence=g.turbulence,
         name=scenario.result,
         aero=scenario.aero,
     )
@@ -78,10 +78,11 @@ def gust_study(scenario: Scenario):
 
 def run_gust_scenario(
     scenario: Scenario,
+    *,
     progress: bool = False,
     scheduler: str | None = None,
     workers: int | None = None,
-) -> tuple[dict, object]:
+) -> Run:
     """Run a ``gust_loads`` scenario.
 
     Parameters
@@ -96,16 +97,15 @@ def run_gust_scenario(
 
     Returns
     -------
-    summary : dict
-        JSON-ready summary (:func:`gust_summary`).
-    result : GustLoadsResult
-        Records and histories of every flight point and loop
-        (:func:`aeroservo.studies.runs.run_scenario` returns both as a ``Run``).
+    Run
+        Its JSON-ready summary (:func:`gust_summary`) and ``loads``, the
+        :class:`~aeroservo.studies.gust_results.GustLoadsResult`: records and histories of every
+        flight point and loop.
     """
     from .gust_run import run_gust_loads
 
     study = gust_study(scenario)
-    n = scenario.gust_loads["workers"] if workers is None else workers
+    n = scenario.gust_loads.workers if workers is None else workers
     result = run_gust_loads(study, workers=n, scheduler=scheduler, progress=progress)
     if not result.records:
         raise InputError(
@@ -113,7 +113,7 @@ def run_gust_scenario(
             "unstable (above its flutter speed) at every point"
             + (" and the closed loop nowhere stable" if study.controller is not None else "")
         )
-    return gust_summary(result, scenario), result
+    return Run(scenario, gust_summary(result, scenario), loads=result, title=scenario.name)
 
 
 def _plain(v: object) -> object:

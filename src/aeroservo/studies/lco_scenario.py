@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import math
 
-from ..errors import InputError
+from ..errors import NumericalError
+from .kinds import Run, check_kind
 from .scenario import Scenario
 
 __all__ = ["lco_setup", "run_lco_scenario", "lco_summary", "lco_figures", "FIGURES"]
@@ -33,8 +34,7 @@ def lco_setup(scenario: Scenario):
     from ..stability.boundary import flutter_boundary
     from .lco import LCOSetup, LCOSweep
 
-    if scenario.kind != "lco" or scenario.lco is None:
-        raise InputError(f"{scenario.source}: scenario.kind = {scenario.kind!r}: not 'lco'")
+    check_kind(scenario, "lco")
     c = scenario.lco
     model = scenario.model()
     vf = flutter_boundary(model, scenario.density).flutter_speed
@@ -43,9 +43,9 @@ def lco_setup(scenario: Scenario):
     extra: dict = {
         "scenario": scenario.name,
         "model": scenario.wing_source,
-        "hinges_source": c["hinges_source"],
+        "hinges_source": c.hinges_source,
         "open_loop_flutter_speed": vf,
-        "describing_function": c["describing"],
+        "describing_function": c.describing,
     }
     loop = ctrl = limits = None
     if spec is not None:
@@ -54,7 +54,7 @@ def lco_setup(scenario: Scenario):
         speed = scenario.speed
         if speed is None:
             if vf is None:
-                raise ArithmeticError(
+                raise NumericalError(
                     f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, "
                     "but the wing has no flutter in the searched range"
                 )
@@ -67,7 +67,7 @@ def lco_setup(scenario: Scenario):
         extra["controller_file"] = str(getattr(spec, "source", "") or "")
     setup = LCOSetup(
         model,
-        c["hinges"],
+        c.hinges,
         scenario.density,
         loop=loop,
         controller=ctrl,
@@ -75,13 +75,13 @@ def lco_setup(scenario: Scenario):
         name=scenario.result,
     )
     sweep = LCOSweep(
-        speeds=tuple(c["speeds"]),
-        amplitudes=tuple(c["amplitudes"]),
-        duration=c["duration"],
-        dt=c["dt"],
-        settle=c["settle"],
-        continuation=c["continuation"],
-        history=c["history"],
+        speeds=tuple(c.speeds),
+        amplitudes=tuple(c.amplitudes),
+        duration=c.duration,
+        dt=c.dt,
+        settle=c.settle,
+        continuation=c.continuation,
+        history=c.history,
         extra=extra,
     )
     return setup, sweep
@@ -89,10 +89,11 @@ def lco_setup(scenario: Scenario):
 
 def run_lco_scenario(
     scenario: Scenario,
+    *,
     progress: bool = False,
     scheduler: str | None = None,
     workers: int | None = None,
-) -> tuple[dict, object]:
+) -> Run:
     """Run an ``lco`` scenario.
 
     Parameters
@@ -107,23 +108,23 @@ def run_lco_scenario(
 
     Returns
     -------
-    summary : dict
-        JSON-ready summary (:func:`lco_summary`).
-    result : LCOResult
-        Every march's verdict and history, and the describing-function branches.
+    Run
+        Its JSON-ready summary (:func:`lco_summary`) and ``lco``, the
+        :class:`~aeroservo.studies.lco_result.LCOResult`: every march's verdict and history,
+        and the describing-function branches.
     """
     from .lco_run import run_lco
 
     setup, sweep = lco_setup(scenario)
     c = scenario.lco
-    n = c["workers"] if workers is None else workers
+    n = c.workers if workers is None else workers
     result = run_lco(
         setup,
         sweep,
         workers=n,
         scheduler=scheduler,
         progress=progress,
-        describing=c["describing"],
+        describing=c.describing,
     )
     notes = result.settings.setdefault("notes", [])
     vf = result.settings.get("open_loop_flutter_speed")
@@ -134,16 +135,16 @@ def run_lco_scenario(
     coarse = _coarse_step(result)
     if coarse:
         notes.append(coarse)
-    if not c["describing"]:
+    if not c.describing:
         notes.append("describing function: not computed (lco.describing = false)")
-    if c.get("wing_hinges_replaced"):
+    if c.wing_hinges_replaced:
         notes.append("hinges: the scenario's [[lco.hinges]] replace the wing file's [[hinges]]")
     if "design_speed" in result.settings:
         notes.append(
             f"controller {result.settings['controller']} designed at "
             f"{result.settings['design_speed']:.4g} m/s, held fixed at every speed"
         )
-    return lco_summary(result, scenario), result
+    return Run(scenario, lco_summary(result, scenario), lco=result, title=scenario.name)
 
 
 MIN_SAMPLES_PER_CYCLE = 20

@@ -1,4 +1,6 @@
-"""Running scenarios: open-loop flutter, closed-loop simulation, trade study.
+"""Running the scenarios of kinds ``flutter`` (open-loop flutter) and ``simulate`` (a
+closed-loop simulation judged over its engaged speeds); :func:`run_scenario` runs any kind
+(:mod:`aeroservo.studies.kinds`).
 
 Each ``run_*`` function computes and returns a :class:`Run`: the JSON-ready summary and the
 result objects behind it. Nothing is written here except a trade study's own case store (its
@@ -10,14 +12,12 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import InputError
+from ..errors import NumericalError
+from .kinds import Run, check_kind, run_scenario
 from .loop_analysis import analyse_loop
 from .scenario import Scenario
 from .verdict import loop_verdict, signal_growth
@@ -25,54 +25,11 @@ from .verdict import loop_verdict, signal_growth
 __all__ = ["Run", "run_scenario", "run_flutter", "run_simulation", "study_from_scenario"]
 
 
-@dataclass
-class Run:
-    """What one scenario run produced.
+def study_from_scenario(scenario: Scenario):
+    """The :class:`~aeroservo.studies.trade.TradeStudy` of a ``trade`` scenario."""
+    from .trade.scenario import study_from_scenario as study
 
-    Attributes
-    ----------
-    scenario : Scenario
-    summary : dict
-        JSON-ready summary (SI units; the ``units`` entry names them).
-    flutter : FlutterResult or None
-        Open-loop boundary (flutter scenarios; the plant's, for simulations).
-    simulation : SimulationResult or None
-        Time histories (simulate scenarios).
-    open_loop : SimulationResult or None
-        The same run with the controller off (same speed, initial state and gust), for the
-        time-history figure's overlay (controlled simulations with plots).
-    boundary : ClosedLoopBoundary or None
-        Closed-loop boundary, when the scenario asks for it.
-    margins : LoopMargins or None
-        Loop margins at the actuator at the scenario's speed (controlled loops).
-    margin_sweep : MarginSweep or None
-        The margins across the engaged speed range (linear controllers).
-    judgement : LoopJudgement or SimulatedJudgement or None
-        The loop judged over its engaged speed range (controlled loops).
-    trade : TradeResult or None
-        Trade-study results (its case store, CSV and NetCDF are already in ``folder``).
-    loads, lco : GustLoadsResult, LCOResult or None
-        Gust loads (gust_loads scenarios), limit cycles (lco scenarios).
-    folder : Path or None
-        Folder of a trade study's outputs.
-    title : str
-        Title of the figures.
-    """
-
-    scenario: Scenario
-    summary: dict
-    flutter: object = None
-    simulation: object = None
-    open_loop: object = None
-    boundary: object = None
-    margins: object = None
-    margin_sweep: object = None
-    judgement: object = None
-    trade: object = None
-    loads: object = None
-    lco: object = None
-    folder: Path | None = None
-    title: str = ""
+    return study(scenario)
 
 
 def _progress_bar(total: float, desc: str, enabled: bool, unit: str = "m/s"):
@@ -93,52 +50,25 @@ def _progress_bar(total: float, desc: str, enabled: bool, unit: str = "m/s"):
 @blas_limited
 def run_flutter(scenario: Scenario, progress: bool = False) -> Run:
     """Open-loop flutter and divergence of the scenario's wing (summary and V-g figure)."""
-    from .flight_condition import aero_record, flutter_at_condition, mach_source
+    from .flight_condition import flutter_analysis
 
     model = scenario.model()
-    atm = scenario.atmosphere
-    cond = (model, scenario.density, atm, scenario.compressibility, scenario.mach)
+    cond = (model, scenario.density, scenario.atmosphere, scenario.compressibility, scenario.mach)
     update, close = _progress_bar(scenario.v_max or 300.0, "flutter sweep", progress)
     try:
-        kw = {} if atm is not None else {"progress": update}
-        fr = flutter_at_condition(*cond, v_max=scenario.v_max, **kw)
+        fa = flutter_analysis(
+            model,
+            scenario.wing.name,
+            cond,
+            v_max=scenario.v_max,
+            pk=scenario.pk,
+            sol145=scenario.sol145,
+            progress=update,
+        )
     finally:
         close()
-    summary = {
-        "scenario": scenario.name,
-        "kind": "flutter",
-        "wing": scenario.wing.name,
-        "flutter_speed": fr.flutter_speed,
-        "flutter_frequency": fr.flutter_frequency,
-        "divergence_speed": fr.divergence_speed,
-        "n_states": fr.n_states,
-        "density": scenario.density,
-        "n_elements": model.n_elements,
-        "wagner": model.wagner.name,
-        "units": {"speed": "m/s", "frequency": "Hz", "density": "kg/m^3"},
-        **aero_record(model, fr.mach, mach_source(scenario.compressibility, scenario.mach, atm)),
-    }
-    summary.update({k: v for k, v in fr.to_dict().items() if k not in summary})
-    sol145 = scenario.sol145
-    if sol145 is not None and sol145["velocities"]:
-        from .flight_condition import sol145_at_condition
-
-        pk, table = sol145_at_condition(cond, fr, sol145)
-        summary["sol145"] = table.to_dict()
-    elif scenario.pk:
-        from ..stability.pk import pk_flutter
-
-        kw = {"boundary": fr} if atm is None else {}
-        pk = flutter_at_condition(*cond, solver=pk_flutter, v_max=fr.v_max, **kw)
-    if scenario.pk or "sol145" in summary:
-        summary["pk_exact_theodorsen" if model.dlm is None else "pk_doublet_lattice"] = {
-            "flutter_speed": pk.flutter_speed,
-            "flutter_frequency": pk.flutter_frequency,
-        }
-
-    aero = model.wagner.name if model.dlm is None else f"doublet lattice, Mach {fr.mach:.3g}"
-    title = f"{scenario.wing.name}: {model.n_elements} elements, {aero}"
-    return Run(scenario, summary, flutter=fr, title=title)
+    summary = {"scenario": scenario.name, "kind": "flutter", **fa.record}
+    return Run(scenario, summary, flutter=fa.boundary, title=fa.title)
 
 
 @blas_limited
@@ -156,8 +86,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     from ..simulate.march import simulate
     from ..stability.boundary import flutter_boundary
 
-    if scenario.kind != "simulate":
-        raise InputError(f"{scenario.source}: scenario.kind = {scenario.kind!r}: not 'simulate'")
+    check_kind(scenario, "simulate")
     t0 = time.perf_counter()
     model = scenario.model()
     fr = flutter_boundary(model, scenario.density)
@@ -165,7 +94,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     if scenario.speed is not None:
         speed = scenario.speed
     elif vf is None:
-        raise ArithmeticError(
+        raise NumericalError(
             f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, but the "
             f"wing has no flutter below {fr.v_max:.4g} m/s"
         )
@@ -291,107 +220,3 @@ def _final_verdict(summary: dict, analysis) -> None:
     if not summary["passed"] and "hint" not in summary:
         summary["hint"] = lines[0] if lines else "the loop fails its verdict"
     summary["verdict_lines"] = lines
-
-
-@blas_limited
-def run_scenario(
-    scenario: Scenario,
-    out_dir: Path | None = None,
-    *,
-    progress: bool = False,
-    scheduler: str | None = None,
-    workers: int | None = None,
-    log: Callable[[str], None] | None = None,
-) -> dict:
-    """Run any scenario.
-
-    Parameters
-    ----------
-    scenario : Scenario
-    out_dir : Path, optional
-        Output folder; a trade study keeps its case store in ``out_dir / scenario.result``
-        (required for trade studies, unused otherwise).
-    progress : bool
-        Progress bars on stderr.
-    scheduler, workers :
-        Dask scheduler address and local workers of a trade, gust-loads or limit-cycle study.
-
-    Returns
-    -------
-    Run
-    """
-    if scenario.kind == "flutter":
-        return run_flutter(scenario, progress)
-    if scenario.kind == "simulate":
-        return run_simulation(scenario, progress)
-    if scenario.kind in ("gust_loads", "lco"):
-        from .gust_scenario import run_gust_scenario
-        from .lco_scenario import run_lco_scenario
-
-        study = {"gust_loads": ("loads", run_gust_scenario), "lco": ("lco", run_lco_scenario)}
-        field, run = study[scenario.kind]
-        summary, res = run(scenario, progress, scheduler, workers)
-        return Run(scenario, summary, **{field: res}, title=scenario.name)
-    from .trade.cluster import run_trade
-
-    if out_dir is None:
-        raise InputError("a trade study needs an output folder (--out)")
-    folder = out_dir / scenario.result
-    res = run_trade(
-        study_from_scenario(scenario),
-        folder,
-        scheduler=scheduler,
-        n_workers=workers or scenario.trade["workers"],
-        progress=progress,
-    )
-    summary = {
-        "scenario": scenario.name,
-        "kind": "trade",
-        "n_cases": res.n_cases,
-        "n_failed": res.n_failed,
-        "n_skipped": res.n_skipped,
-        "elapsed": res.elapsed,
-        "cases_per_second": (res.n_cases - res.n_skipped) / max(res.elapsed, 1e-9),
-    }
-    best = res.best_case()  # the case the figures outline (trade.ranking)
-    if best is not None:
-        summary["best_case"] = {
-            k: (v.item() if hasattr(v, "item") else v) for k, v in best.items() if v == v
-        }
-        summary["best_case_criterion"] = res.best_criterion
-    return Run(scenario, summary, trade=res, folder=folder)
-
-
-def study_from_scenario(scenario: Scenario):
-    """The :class:`~aeroservo.studies.trade.TradeStudy` of a ``trade`` scenario."""
-    from .trade.study import TradeStudy
-
-    t = scenario.trade
-    return TradeStudy(
-        base_wing=scenario.wing,
-        density=scenario.density,
-        damping=scenario.damping,
-        elements=scenario.elements,
-        wagner=scenario.wagner,
-        aero=scenario.aero,
-        controls=tuple(scenario.controls),
-        sensors=tuple(scenario.sensors),
-        outputs=tuple(scenario.outputs),
-        design_modes=scenario.design_modes,
-        sensor_filter=scenario.sensor_filter,
-        filter_order=scenario.filter_order,
-        gust_model=scenario.gust_model,
-        controller=t["controller"],
-        sample_rate=scenario.sample_rate,
-        delay=scenario.delay,
-        actuator=scenario.actuator,
-        parameters=dict(t["parameters"]),
-        speed_factor=t["speed_factor"],
-        gust_length=t["gust_length"],
-        gust_amplitude=t["gust_amplitude"],
-        gust_duration=t["gust_duration"],
-        v_max_factor=t["v_max_factor"],
-        n_grid=t["n_grid"],
-        name=scenario.result,
-        closed_loop=t.get("closed_loop", True),
-    )

@@ -10,12 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..design.spec import ControllerSpec
+from ..errors import NumericalError
 from ..system.damping import NO_DAMPING, StructuralDamping
+from .study_options import GustLoadsOptions, LCOOptions, TradeOptions
 
-__all__ = ["Scenario", "Disturbance", "quick", "SCENARIO_KINDS"]
+__all__ = ["Scenario", "Disturbance", "quick"]
 
 
-SCENARIO_KINDS = ("flutter", "simulate", "trade", "gust_loads", "lco")
 GUST_TYPES = ("none", "one_minus_cosine", "turbulence", "series")
 GUST_KEYS = {
     "none": (),
@@ -45,12 +46,11 @@ class Disturbance:
 class Scenario:
     """A validated scenario (SI units). See ``docs/scenarios.md`` for every key.
 
-    ``trade`` holds a trade study's table and ``gust_loads`` a gust-loads study's (a dict:
-    ``loads``, ``points`` (:class:`~aeroservo.studies.gust_loads.FlightPoint`), ``mass_cases``
-    (name -> wing, the first the default), ``design_mass_case``, ``n_gradients``,
-    ``turbulence``, ``workers``, ``f_g`` or ``weights``) and ``lco`` a limit-cycle study's
-    (``hinges``, ``speeds``, ``amplitudes``, ``duration``, ``dt``, ``settle``, ``continuation``,
-    ``history``, ``workers``, ``describing``, ``hinges_source``); None for the other kinds. A
+    ``options`` holds the typed options of a study's table
+    (:mod:`~aeroservo.studies.study_options`: a trade study's ``[trade]``, a gust-loads study's
+    ``[gust_loads]``, a limit-cycle study's ``[lco]``), also read as ``trade``, ``gust_loads``
+    and ``lco`` (None for the other kinds); the kinds are
+    :data:`aeroservo.studies.kinds.KINDS`. A
     limit-cycle study on a typical section has ``section`` (a
     :class:`~aeroservo.system.section.TypicalSection`) and no ``wing``. ``aero`` is the
     doublet-lattice settings (a :class:`~aeroservo.aero.dlm_settings.DoubletLattice`; None:
@@ -101,12 +101,25 @@ class Scenario:
     margin_speeds: int = 9
     result: str = ""
     plots: bool = True
-    trade: object = None
-    gust_loads: object = None
-    lco: object = None
+    options: object = None  # the kind's typed options (studies/study_options), None: none
     section: object = None
     aero: object = None
     mach: float | None = None
+
+    @property
+    def trade(self) -> TradeOptions | None:
+        """A trade study's options (``[trade]``), None for the other kinds."""
+        return self.options if isinstance(self.options, TradeOptions) else None
+
+    @property
+    def gust_loads(self) -> GustLoadsOptions | None:
+        """A gust-loads study's options (``[gust_loads]``), None for the other kinds."""
+        return self.options if isinstance(self.options, GustLoadsOptions) else None
+
+    @property
+    def lco(self) -> LCOOptions | None:
+        """A limit-cycle study's options (``[lco]``), None for the other kinds."""
+        return self.options if isinstance(self.options, LCOOptions) else None
 
     def model(self):
         """The aeroelastic model of the scenario's wing and options (its typical section, if
@@ -140,7 +153,7 @@ class Scenario:
             return EngagedRange(*self.engaged_speeds, "scenario: controller.engaged_speeds")
         if self.engaged_speed_factors is not None:
             if flutter_speed is None:
-                raise ArithmeticError(
+                raise NumericalError(
                     f"{self.source}: controller.engaged_speed_factors needs the open-loop "
                     "flutter speed, but the wing has none in the searched range"
                 )
@@ -177,36 +190,16 @@ class Scenario:
 
 def quick(s: Scenario) -> Scenario:
     """Fast settings of a scenario for smoke tests: at most 0.5 s simulated, an 11-point
-    closed-loop grid, 3 margin speeds, two values per trade parameter and a 0.3 s gust in
-    trade studies; gust loads at the first two flight points with at most 5 gust gradients;
-    limit cycles at the first, middle and last speeds from the smallest and largest initial
-    rotations, at most 2 s each and no describing function."""
+    closed-loop grid, 3 margin speeds, and the study's own quick options (two values per trade
+    parameter and a 0.3 s gust in trade studies; gust loads at the first two flight points with
+    at most 5 gust gradients; limit cycles at the first, middle and last speeds from the
+    smallest and largest initial rotations, at most 2 s each and no describing function)."""
     from dataclasses import replace
 
-    kw: dict = {
-        "duration": min(s.duration, 0.5),
-        "n_grid": min(s.n_grid, 11),
-        "margin_speeds": min(s.margin_speeds, 3),
-    }
-
-    if s.trade is not None:
-        t = dict(s.trade)
-        t["parameters"] = {k: v[:2] for k, v in t["parameters"].items()}
-        t["gust_duration"] = min(t["gust_duration"], 0.3)
-        t["n_grid"] = min(t["n_grid"], 11)
-        kw["trade"] = t
-    if s.gust_loads is not None:
-        g = dict(s.gust_loads)
-        g["points"] = tuple(g["points"][:2])
-        g["n_gradients"] = min(g["n_gradients"], 5)
-        kw["gust_loads"] = g
-    if s.lco is not None:
-        c = dict(s.lco)
-        v, a = c["speeds"], sorted(c["amplitudes"])
-        c["speeds"] = tuple(sorted({v[0], v[len(v) // 2], v[-1]}))
-        c["amplitudes"] = tuple(sorted({a[0], a[-1]}))
-        c["duration"] = min(c["duration"], 2.0)
-        c["history"] = min(c["history"], c["duration"])
-        c["describing"] = False
-        kw["lco"] = c
-    return replace(s, **kw)
+    return replace(
+        s,
+        duration=min(s.duration, 0.5),
+        n_grid=min(s.n_grid, 11),
+        margin_speeds=min(s.margin_speeds, 3),
+        options=None if s.options is None else s.options.quick(),
+    )

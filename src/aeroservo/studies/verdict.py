@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import VerdictFailure
+
 __all__ = ["signal_growth", "loop_verdict", "TAIL", "GROWS", "EXIT_UNSTABLE"]
 
 TAIL = 0.2
@@ -29,8 +31,9 @@ TAIL = 0.2
 GROWS = 1.05
 """A signal whose last peak exceeds its earlier peak by more than this factor grows."""
 
-EXIT_UNSTABLE = 3
-"""Exit status of ``aeroservo simulate`` when the loop is unstable (and not expected to be)."""
+EXIT_UNSTABLE = VerdictFailure.exit_code
+"""Exit status of ``aeroservo simulate`` when the loop is unstable (and not expected to be):
+:class:`~aeroservo.errors.VerdictFailure`'s."""
 
 
 def signal_growth(y: np.ndarray, tail: float = TAIL) -> float:

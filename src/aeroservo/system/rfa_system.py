@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..aero.rfa import RationalFit
+from ..errors import NumericalError
 from .first_order import FirstOrderSystem
 
 __all__ = ["rfa_blocks", "rfa_first_order"]
@@ -96,7 +97,7 @@ def rfa_first_order(
     n_z = F.shape[0]
     M = Ms - half * b * b * fit.A2
     if np.linalg.eigvalsh(0.5 * (M + M.T)).min() <= 0.0:
-        raise ArithmeticError(
+        raise NumericalError(
             f"the rational approximation's apparent mass makes the mass matrix indefinite at "
             f"{rho:g} kg/m^3: fit fewer lag roots or a narrower k range"
         )

@@ -70,11 +70,12 @@ def run_trade(
     out_dir: str | Path,
     *,
     scheduler: str | None = None,
-    n_workers: int = 2,
+    workers: int = 2,
     progress: bool = True,
     timeout: float = 60.0,
     connect_timeout: float = 5.0,
     worker_timeout: float = 10.0,
+    n_workers: int | None = None,
 ) -> TradeResult:
     """Run a trade study on Dask, skipping the cases already finished in ``out_dir``.
 
@@ -86,9 +87,11 @@ def run_trade(
         ``<name>.nc`` and ``study.json``.
     scheduler : str, optional
         Address ``tcp://host:port`` of a running Dask scheduler whose workers can import this
-        version of aeroservo. Default: a local cluster of ``n_workers`` processes.
-    n_workers : int
-        Worker processes of the local cluster.
+        version of aeroservo. Default: a local cluster of ``workers`` processes.
+    workers : int
+        Worker processes of the local cluster (as ``workers`` of
+        :func:`~aeroservo.studies.gust_run.run_gust_loads` and
+        :func:`~aeroservo.studies.lco_run.run_lco`; a trade study runs on at least one).
     progress : bool
         Show a tqdm progress bar over the cases as they finish.
     timeout : float
@@ -97,6 +100,8 @@ def run_trade(
         Time allowed to reach the scheduler [s].
     worker_timeout : float
         Time allowed for the scheduler to have a worker [s].
+    n_workers : int, optional
+        Deprecated name of ``workers``.
 
     Returns
     -------
@@ -128,7 +133,14 @@ def run_trade(
         raise InputError(f"study = {study!r}: expected a TradeStudy")
     if scheduler is not None:
         scheduler = check_address(scheduler)
-    n_workers = check_int("n_workers", n_workers, lo=1, hi=256)
+    if n_workers is not None:
+        import warnings
+
+        warnings.warn(
+            "run_trade(n_workers=...) is deprecated: use workers=", DeprecationWarning, stacklevel=2
+        )
+        workers = n_workers
+    n_workers = check_int("workers", workers, lo=1, hi=256)
     timeout = check_number("timeout", timeout, unit="s", lo=0.0, lo_open=True)
     connect_timeout = check_number(
         "connect_timeout", connect_timeout, unit="s", lo=0.0, lo_open=True
