@@ -14,7 +14,7 @@ from aeroservo._c_stdout import c_stdout_silenced as quiet_stdout  # noqa: F401 
 from aeroservo.design import (
     Bryson,
     Limits,
-    lqr,
+    lqr_controller,
     state_map,
     with_sensor_filters,
 )
@@ -38,7 +38,9 @@ def build() -> dict:
     db = aes.StateSpaceBuilder(model, RHO, ins, outs, n_modes=8)
     plant, design = pb.at(speed), db.at(speed)
     bryson = Bryson(outputs={"tip_disp": 0.05, "tip_twist": 0.02}, inputs={CONTROL: 500.0})
-    gain = lqr(design, [CONTROL], bryson=bryson, sample_rate=1 / DT, state_map=state_map(pb, db))
+    gain = lqr_controller(
+        design, [CONTROL], bryson=bryson, sample_rate=1 / DT, state_map=state_map(pb, db)
+    )
     limits = Limits(magnitude={CONTROL: 2000.0}, rate={CONTROL: 2e5})
     x0 = tip_deflection_state(pb, TIP)
     plant_f = with_sensor_filters(plant, SENSORS[:2], 30.0)

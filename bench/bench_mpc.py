@@ -3,12 +3,13 @@
 Case: ``_control_case.py`` (Goland with the illustrative aileron, 10 elements, 1.1 V_f, 1 kHz).
 MPC (horizon 20, magnitude and rate limits, 8-mode design model with the sensor filters,
 Kalman-filter state), 1 s closed loop on the full plant: median and 99th percentile of the QP
-solve time per step for each solver of ``aeroservo.design.mpc.SOLVERS`` that works (a solver
-that hangs on the QPs of the first solver's run is reported and skipped); target: median
-< 1 ms. Baseline: the same problem in do-mpc (discrete model, states as variables, IPOPT) if
-``do_mpc`` is importable, else casadi ``Opti`` + IPOPT on the same condensed QP (``--opti``
-forces it), at the estimated states of the first solver's run; IPOPT is told to scale the
-objective by 1 / max diag(H) (its tolerances are absolute; the QP's Hessian is ~1e-8).
+solve time per step for each solver of ``aeroservo.design.model_predictive.SOLVERS`` that
+works (a solver that hangs on the QPs of the first solver's run is reported and skipped);
+target: median < 1 ms. Baseline: the same problem in do-mpc (discrete model, states as
+variables, IPOPT) if ``do_mpc`` is importable, else casadi ``Opti`` + IPOPT on the same
+condensed QP (``--opti`` forces it), at the estimated states of the first solver's run; IPOPT
+is told to scale the objective by 1 / max diag(H) (its tolerances are absolute; the QP's
+Hessian is ~1e-8).
 
 Run: ``make bench`` (or ``python bench/bench_mpc.py``). Medians of repeated runs; on a shared
 or loaded machine the 99th percentiles mostly measure scheduler preemption.
@@ -28,8 +29,8 @@ from aeroservo.design import (
     bryson_weights,
     mpc,
 )
-from aeroservo.design.lqg import solve_dare
-from aeroservo.design.mpc import SOLVERS
+from aeroservo.design.model_predictive import SOLVERS
+from aeroservo.design.riccati import solve_dare
 from aeroservo.simulate import simulate
 
 
@@ -150,7 +151,7 @@ def baseline_do_mpc(s: dict, ctrl, samples):
     Q, R, N = bryson_weights(s["design_f"], [CONTROL], s["bryson"])
     Qd, Rd, Nd = Q * DT, R * DT, N * DT
     rn = np.linalg.solve(Rd, Nd.T)
-    P = solve_dare(sp.Phi - sp.Gu @ rn, sp.Gu, Qd - Nd @ rn, Rd)  # as in aeroservo.design.mpc
+    P = solve_dare(sp.Phi - sp.Gu @ rn, sp.Gu, Qd - Nd @ rn, Rd)  # as in design.model_predictive
     n, m = sp.Gu.shape
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

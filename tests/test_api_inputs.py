@@ -17,7 +17,14 @@ from hypothesis import strategies as st
 
 import aeroservo as aes
 from aeroservo.aero import GustSeries, OneMinusCosine, Turbulence
-from aeroservo.design import Bryson, Limits, OpenLoop, lqr, state_map, with_sensor_filters
+from aeroservo.design import (
+    Bryson,
+    Limits,
+    OpenLoop,
+    lqr_controller,
+    state_map,
+    with_sensor_filters,
+)
 from aeroservo.errors import InputError
 from aeroservo.linear import Sensor, Servo, StateSpaceBuilder, discretize, statespace_family
 from aeroservo.linear.models import tip_deflection_state
@@ -65,7 +72,7 @@ def ss(c, **kw):
 
 def design_lqr(c, **kw):
     args = {"sys": c.design, "controls": [HM], "Q": c.I, "R": c.R} | kw
-    return lqr(args.pop("sys"), args.pop("controls"), **args)
+    return lqr_controller(args.pop("sys"), args.pop("controls"), **args)
 
 
 def sim(c, **kw):
@@ -210,8 +217,12 @@ CORPUS = [
     ("lqr-rate-huge", lambda c: design_lqr(c, sample_rate=1e9), "sample_rate = 1e+09"),
     ("lqr-state-map-rows", lambda c: design_lqr(c, state_map=np.eye(3)), "state_map has 3 rows"),
     ("lqr-state-map-string", lambda c: design_lqr(c, state_map="x"), "state_map = 'x'"),
-    ("lqr-bryson-dict", lambda c: lqr(c.design, [HM], bryson={"tip_disp": 1}), "bryson = {"),
-    ("lqr-no-weights", lambda c: lqr(c.design, [HM]), "give Q and R, or bryson"),
+    (
+        "lqr-bryson-dict",
+        lambda c: lqr_controller(c.design, [HM], bryson={"tip_disp": 1}),
+        "bryson = {",
+    ),
+    ("lqr-no-weights", lambda c: lqr_controller(c.design, [HM]), "give Q and R, or bryson"),
     (
         "bryson-outputs-list",
         lambda c: Bryson(outputs=["tip_disp"], inputs={HM: 1.0}),
@@ -411,4 +422,6 @@ def test_fuzz_servo(ctx, order, bandwidth, damping):
 @FUZZ
 @given(rate=mixed(1.0, 1e5))
 def test_fuzz_lqr_sample_rate(ctx, rate):
-    succeeds_or_refuses(lambda: lqr(ctx.design, [HM], bryson=ctx.bryson, sample_rate=rate))
+    succeeds_or_refuses(
+        lambda: lqr_controller(ctx.design, [HM], bryson=ctx.bryson, sample_rate=rate)
+    )

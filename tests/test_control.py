@@ -22,7 +22,7 @@ from aeroservo.design import (
     closed_loop_boundary,
     closed_loop_matrix,
     lqg,
-    lqr,
+    lqr_controller,
     mpc,
     schedule,
     state_map,
@@ -77,7 +77,7 @@ def case(aileron10):
 
 @pytest.fixture(scope="module")
 def K(case):
-    return lqr(case.design(), CONTROLS, bryson=BRYSON, state_map=case.T)
+    return lqr_controller(case.design(), CONTROLS, bryson=BRYSON, state_map=case.T)
 
 
 @pytest.fixture(scope="module")
@@ -229,7 +229,7 @@ def test_saturated_lqr_loses_stability_where_mpc_keeps_it(case):
     br = Bryson(outputs={"tip_disp": 0.05, "tip_twist": 0.02}, inputs={HM: 5000.0})
     lim = Limits(magnitude={HM: 300.0}, rate={HM: 1e5})
     rate = 250.0
-    Kx = lqr(case.design(), CONTROLS, bryson=br, state_map=case.T, sample_rate=rate)
+    Kx = lqr_controller(case.design(), CONTROLS, bryson=br, state_map=case.T, sample_rate=rate)
     with pytest.warns(RuntimeWarning, match="run away while the actuator saturates"):
         r_lqr = simulate(case.plant(), Kx, duration=3.0, x0=case.x0(0.031), limits=lim)
     assert r_lqr.windup()  # issue 24: the diverging saturated loop is reported
@@ -287,7 +287,9 @@ def test_continuous_and_sampled_boundaries_agree(case, K, lqr_boundary):
 
 def test_gain_schedule_widens_the_stable_range(case, K, lqr_boundary):
     speeds = np.linspace(0.5, 1.7, 13) * case.vf
-    S = schedule(lambda v: lqr(case.design(v), CONTROLS, bryson=BRYSON, state_map=case.T), speeds)
+    S = schedule(
+        lambda v: lqr_controller(case.design(v), CONTROLS, bryson=BRYSON, state_map=case.T), speeds
+    )
     at = S.at(speeds[3])
     np.testing.assert_array_equal(at.Kd, S.controllers[3].Kd)
     mid = S.at(0.5 * (speeds[3] + speeds[4]))
@@ -382,9 +384,9 @@ def test_computational_delay_matches_its_closed_loop(case, K):
 
 def test_bad_controller_inputs(case):
     with pytest.raises(InputError, match="Q and R, or bryson"):
-        lqr(case.design(), CONTROLS)
+        lqr_controller(case.design(), CONTROLS)
     with pytest.raises(InputError, match="not a signal"):
-        lqr(case.design(), ["elevator_hinge_moment"], bryson=BRYSON)
+        lqr_controller(case.design(), ["elevator_hinge_moment"], bryson=BRYSON)
     with pytest.raises(InputError, match="missing"):
         lqg(
             case.design(),

@@ -20,7 +20,7 @@ import scipy.linalg as sla
 import aeroservo as aes
 from aeroservo.aero.atmosphere import isa
 from aeroservo.aero.dlm import aics
-from aeroservo.design import Bryson, lqr, state_map
+from aeroservo.design import Bryson, lqr_controller, state_map
 from aeroservo.errors import InputError
 from aeroservo.linear.models import tip_deflection_state
 from aeroservo.linear.state_space import StateSpaceBuilder
@@ -105,7 +105,7 @@ def test_lqr_on_the_dlm_plant_stabilizes_the_sampled_loop(aileron_dlm):
     pb = StateSpaceBuilder(aileron_dlm, RHO, ins, outs)
     db = StateSpaceBuilder(aileron_dlm, RHO, ins, outs, n_modes=8)
     bryson = Bryson(outputs={"tip_disp": 0.05, "tip_twist": 0.02}, inputs={HM: 500.0})
-    K = lqr(db.at(v), [HM], bryson=bryson, state_map=state_map(pb, db))
+    K = lqr_controller(db.at(v), [HM], bryson=bryson, state_map=state_map(pb, db))
     P = pb.at(v)
     A, B = np.asarray(P.A), np.asarray(P.B)[:, [0]]
     n = A.shape[0]

@@ -51,6 +51,10 @@ _PUBLIC = {
     "save_result": "files.results",
     "statespace": "linear.models",
     "statespace_family": "linear.models",
+    "as_controller": "design.interface",
+    "Controller": "design.protocol",
+    "LinearController": "design.protocol",
+    "ScheduledController": "design.protocol",
 }
 _SUBPACKAGES = {
     "examples": "structure.examples",

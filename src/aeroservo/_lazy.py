@@ -4,9 +4,10 @@ A package lists its public names and the module each lives in; importing the pac
 costs nothing, and ``from aeroservo.files import load_wing`` imports only ``wing_file``. This
 keeps the command line's start-up to what a command needs (issue 17).
 
-A public name must not be the name of one of the package's modules (``design.lqr`` is both a
-module and a function): importing the module binds the package attribute to it, and the
-function would never be looked up. Such packages keep eager imports (``aeroservo.design``).
+A public name must not be the name of one of the package's modules (``design.lqr`` was both a
+module and a function until issue 39): importing the module binds the package attribute to it,
+and the function would never be looked up. ``aeroservo.design`` still imports its modules
+eagerly.
 """
 
 from __future__ import annotations

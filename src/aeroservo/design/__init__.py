@@ -1,8 +1,10 @@
 """Flutter-suppression controller design and the analysis of any controller's loop.
 
 python-control designs the linear loops (LQR, LQG, H-infinity); casadi solves the MPC quadratic
-programs. Every controller is a *sampled* controller; :func:`as_controller` takes one designed
-here or elsewhere (a python-control ``StateSpace``/``TransferFunction``, a
+programs. Every controller is a *sampled* controller with the attributes of the protocol
+:class:`Controller` (a linear one those of :class:`LinearController`, a gain schedule those of
+:class:`ScheduledController`; :mod:`aeroservo.design.protocol`); :func:`as_controller` takes one
+designed here or elsewhere (a python-control ``StateSpace``/``TransferFunction``, a
 :func:`static_gain`, a :func:`python_law`), and the same object works in
 :func:`aeroservo.simulate.simulate`, :func:`closed_loop_boundary`, :func:`loop_margins`,
 :func:`margins_over_speed` and :func:`judge_loop`. A :class:`ControlLoop` holds the plant and
@@ -14,19 +16,20 @@ from .actuator import ActuatorDynamics
 from .boundary_result import ClosedLoopBoundary
 from .closed_loop import closed_loop_boundary, closed_loop_matrix
 from .compensator import DiscreteCompensator, compensator_from_lti
+from .gain_schedule import GainSchedule, schedule
 from .hinge_loop import loop_hinge_plant
-from .interface import PythonLaw, StateGain, as_controller, python_law, static_gain
+from .interface import PythonLaw, StaticGain, as_controller, python_law, static_gain
 from .judgement import EngagedRange, LoopJudgement, judge_loop
 from .law import LinearLaw
 from .loop import ControlLoop
-from .lqg import KalmanFilter, OutputFeedback, kalman_filter, lqg
-from .lqr import Bryson, StateFeedback, bryson_weights, lqr
 from .margin_sweep import MarginSweep, margins_over_speed
 from .margins import LoopMargins, MarginRequirement, loop_margins
-from .mpc import MPCController, mpc
+from .model_predictive import MPCController, mpc
+from .output_feedback import KalmanFilter, OutputFeedback, kalman_filter, lqg
 from .plant import Limits, OpenLoop, SampledPlant, state_map, with_sensor_filters
-from .schedule import GainSchedule, schedule
+from .protocol import Controller, LinearController, ScheduledController
 from .spec import ControllerSpec
+from .state_feedback import Bryson, StateFeedback, bryson_weights, lqr, lqr_controller
 
 __all__ = [
     "ActuatorDynamics",
@@ -34,12 +37,14 @@ __all__ = [
     "Bryson",
     "ClosedLoopBoundary",
     "ControlLoop",
+    "Controller",
     "ControllerSpec",
     "DiscreteCompensator",
     "EngagedRange",
     "GainSchedule",
     "KalmanFilter",
     "Limits",
+    "LinearController",
     "LinearLaw",
     "LoopJudgement",
     "LoopMargins",
@@ -50,8 +55,9 @@ __all__ = [
     "OutputFeedback",
     "PythonLaw",
     "SampledPlant",
+    "ScheduledController",
     "StateFeedback",
-    "StateGain",
+    "StaticGain",
     "as_controller",
     "bryson_weights",
     "closed_loop_boundary",
@@ -61,7 +67,8 @@ __all__ = [
     "kalman_filter",
     "loop_margins",
     "lqg",
-    "lqr",
+    "lqr",  # deprecated: lqr_controller
+    "lqr_controller",
     "margins_over_speed",
     "mpc",
     "python_law",
@@ -70,3 +77,19 @@ __all__ = [
     "static_gain",
     "with_sensor_filters",
 ]
+
+
+def __getattr__(name: str) -> object:
+    """Deprecated names, kept one release: ``StateGain`` (now :class:`StaticGain`, which also
+    holds a gain on sensors)."""
+    if name == "StateGain":
+        import warnings
+
+        warnings.warn(
+            "aeroservo.design.StateGain is deprecated and will be removed in the next release: "
+            "use aeroservo.design.StaticGain (static_gain builds it, on sensors or states)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return StaticGain
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -24,8 +24,9 @@ import numpy as np
 
 from ..errors import InputError
 from .compensator import DiscreteCompensator
-from .lqg import OutputFeedback
-from .schedule import GainSchedule
+from .gain_schedule import GainSchedule
+from .interface import StaticGain
+from .output_feedback import OutputFeedback
 
 __all__ = ["with_anti_windup", "has_anti_windup"]
 
@@ -38,6 +39,8 @@ def has_anti_windup(controller) -> bool | None:
         return has_anti_windup(controller.controllers[0])
     if isinstance(controller, DiscreteCompensator):
         return controller.n_states > 0 and bool(np.any(controller.anti_windup))
+    if isinstance(controller, StaticGain) and not controller.needs_state:
+        return False  # a compensator without state: nothing to wind up
     return None
 
 
@@ -71,6 +74,8 @@ def with_anti_windup(controller, on: bool):
         own = controller.anti_windup
         gain = (own if np.any(own) else None) if on else np.zeros_like(own)
         return replace(controller, anti_windup=gain)
+    if isinstance(controller, StaticGain) and not controller.needs_state:
+        return controller  # a static gain on sensors: nothing to wind up, nothing to switch
     name = getattr(controller, "name", "") or type(controller).__name__
     raise InputError(
         f"anti_windup: not a switch of {name} (an LQR, static gain or open loop has no state "

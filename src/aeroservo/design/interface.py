@@ -5,17 +5,19 @@ verdicts, scenarios and trade studies.
 :func:`as_controller` takes
 
 * a controller of :mod:`aeroservo.design` (LQR, LQG, MPC, H-infinity, gain schedule, open loop,
-  :class:`~aeroservo.design.compensator.DiscreteCompensator`, :class:`StateGain`,
+  :class:`~aeroservo.design.compensator.DiscreteCompensator`, :class:`StaticGain`,
   :class:`PythonLaw`): returned as it is;
 * a python-control ``StateSpace`` or ``TransferFunction`` whose inputs are named after sensors
   and outputs after controls: discrete at the loop's period, or continuous and discretised at
   the loop's sample rate (:func:`~aeroservo.design.compensator.compensator_from_lti`);
-* an object with the sampled-controller protocol (``dt``, ``controls``, ``reset``,
+* an object with the attributes of the sampled-controller protocol
+  (:class:`~aeroservo.design.protocol.Controller`: ``dt``, ``controls``, ``reset()``,
   ``command(y, x)``, ``update(y, u)``): a nonlinear law, simulated as it is.
 
 Static gains (:func:`static_gain`, on named sensors or named plant states) and Python functions
 (:func:`python_law`) need their signal names, so they are built by those functions. Anything
-else is an :class:`~aeroservo.errors.InputError`. Linear controllers have a
+else is an :class:`~aeroservo.errors.InputError`. Linear controllers
+(:class:`~aeroservo.design.protocol.LinearController`) have a
 :class:`~aeroservo.design.law.LinearLaw` (``law``); the linear analyses (boundary, margins)
 refuse a controller without one, never treating it as an open loop.
 """
@@ -29,39 +31,39 @@ import numpy as np
 
 from ..errors import InputError
 from ..linear.signals import check_names, describe
-from .compensator import DiscreteCompensator, check_period, compensator_from_lti, sample_period
+from .compensator import check_period, compensator_from_lti, sample_period
 from .law import LinearLaw, state_gain
+from .protocol import Controller, ScheduledController
 
 __all__ = [
     "as_controller",
     "controller_at",
     "static_gain",
     "python_law",
-    "StateGain",
+    "StaticGain",
     "PythonLaw",
     "has_linear_law",
-    "PROTOCOL",
 ]
 
-PROTOCOL = ("dt", "controls", "reset", "command", "update")
-"""Attributes of a sampled controller (the protocol :func:`aeroservo.simulate.simulate` runs)."""
-
 ACCEPTED = (
-    "a controller of aeroservo.design (lqr, lqg, mpc, hinf, schedule, static_gain, "
+    "a controller of aeroservo.design (lqr_controller, lqg, mpc, hinf, schedule, static_gain, "
     "python_law, DiscreteCompensator), a python-control StateSpace or TransferFunction with "
     "inputs named after sensors and outputs after controls, or an object with dt, controls, "
     "reset(), command(y, x) and update(y, u)"
 )
 
 
-def has_linear_law(controller) -> bool:
-    """Whether a controller (or a gain schedule) has a linear law the analyses can use."""
+def has_linear_law(controller: object) -> bool:
+    """Whether a controller (or a gain schedule) has a linear law the analyses can use: a
+    :class:`~aeroservo.design.protocol.LinearController` (its ``law``) or a
+    :class:`~aeroservo.design.protocol.ScheduledController` (its ``at``)."""
     return callable(getattr(controller, "law", None)) or hasattr(controller, "at")
 
 
-def controller_at(controller, speed: float):
+def controller_at(controller: Controller | ScheduledController, speed: float) -> Controller:
     """The controller in force at ``speed`` [m/s]: a schedule (anything with ``at``) evaluated
-    there and what it returns checked by :func:`as_controller` at the schedule's rate."""
+    there and what it returns checked by :func:`as_controller` at the schedule's rate; any
+    other controller as it is."""
     if not hasattr(controller, "at"):
         return controller
     inner = controller.at(speed)
@@ -71,13 +73,13 @@ def controller_at(controller, speed: float):
 
 
 def as_controller(
-    obj,
+    obj: object,
     *,
     sample_rate: float | None = None,
     method: str = "tustin",
     prewarp: float | None = None,
     sign: int = 1,
-) -> object:
+) -> Controller | ScheduledController:
     """Any supported controller as a sampled controller of this package (module docstring).
 
     Parameters
@@ -91,13 +93,20 @@ def as_controller(
         Discretisation and sign of a python-control system, see
         :func:`~aeroservo.design.compensator.compensator_from_lti`.
 
+    Returns
+    -------
+    Controller or ScheduledController
+        ``obj`` itself when it is a controller (a :class:`~aeroservo.design.protocol.Controller`,
+        a controller with a linear law, or a gain schedule), else a
+        :class:`~aeroservo.design.compensator.DiscreteCompensator`.
+
     Raises
     ------
     InputError
         For an object that is none of the accepted kinds, or a period other than the loop's.
     """
     dt_loop = sample_period(sample_rate)
-    if has_linear_law(obj) or all(hasattr(obj, a) for a in PROTOCOL):
+    if has_linear_law(obj) or isinstance(obj, Controller):
         dt = getattr(obj, "dt", None)
         if not isinstance(dt, (int, float, np.floating)) or isinstance(dt, bool) or not dt > 0:
             raise InputError(f"controller.dt = {describe(dt)}: expected a sample period [s] > 0")
@@ -125,24 +134,67 @@ def as_controller(
 
 
 @dataclass
-class StateGain:
-    """``u = -K x[states]``: a static gain on named plant states.
+class StaticGain:
+    """``u = sign K m``: a static gain, without controller state, on named sensors (``m = y``)
+    or on named plant states (``m`` the named entries of the plant state ``x``).
 
     The states are those of the plant the loop closes around (``plant.state_labels``; the
     models of :class:`~aeroservo.StateSpaceBuilder` and ``aes.statespace`` are balanced, so a
     gain designed on them applies as it is). Use :func:`static_gain` to build one.
+
+    Attributes
+    ----------
+    K : ndarray (n_controls, n_sensors or n_states)
+        The gain, in the signals' units (e.g. N m per rad).
+    controls : tuple of str
+        The commands (rows of ``K``).
+    sensors : tuple of str
+        The measured sensors (columns of ``K``), or ``()`` for a gain on states.
+    states : tuple of str
+        The plant states (columns of ``K``), or ``()`` for a gain on sensors.
+    dt : float
+        Sample period [s].
+    sign : {-1, 1}
+        ``-1``: ``u = -K m`` (negative feedback, ``control.lqr``'s K); ``1``: ``u = +K m``.
+    design_speed : float
+        [m/s] (NaN if unknown).
     """
 
     K: np.ndarray
     controls: tuple
+    sensors: tuple
     states: tuple
     dt: float
+    sign: int = -1
     design_speed: float = float("nan")
-    needs_state: bool = True
-    _gain: np.ndarray | None = field(default=None, repr=False)
+    _placed: np.ndarray = field(init=False, repr=False, compare=False)
 
-    def law(self, states: Sequence[str]) -> LinearLaw:
-        """The law on a plant with the named ``states`` (every named state must be one)."""
+    def __post_init__(self) -> None:
+        # u = -G x: the gain on the named states in their order, until law() places it on a
+        # plant's states
+        self._placed = -self.sign * self.K
+
+    @property
+    def needs_state(self) -> bool:
+        """Whether it feeds back plant states (a gain on ``states``) rather than sensors."""
+        return bool(self.states)
+
+    @property
+    def gain(self) -> np.ndarray:
+        """``sign K``: the matrix with ``u = gain @ m``."""
+        return self.sign * self.K
+
+    def law(self, states: Sequence[str] = ()) -> LinearLaw:
+        """The law around a plant with the named ``states`` (plant state names, filters
+        included): a gain on states places its columns on them (every named state must be one
+        of them); a gain on sensors ignores them."""
+        if not self.states:
+            m, p = self.K.shape
+            z = np.zeros
+            return LinearLaw(
+                z((0, 0)), z((0, p)), z((m, 0)), self.sign * self.K, z((0, m)),
+                self.controls, self.sensors, self.dt, "compensator", "static output gain",
+            )  # fmt: skip
         states = list(states)
         missing = [s for s in self.states if s not in states]
         if missing:
@@ -151,17 +203,26 @@ class StateGain:
                 f"({len(states)} states, e.g. {states[:4]})"
             )
         G = np.zeros((len(self.controls), len(states)))
-        G[:, [states.index(s) for s in self.states]] = self.K
-        self._gain = G
+        G[:, [states.index(s) for s in self.states]] = -self.sign * self.K
+        self._placed = G
         return state_gain(G, self.controls, self.dt, source="static state gain")
 
     def reset(self) -> None:
         pass
 
-    def command(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
-        if self._gain is None or self._gain.shape[1] != np.size(x):
-            raise InputError("static gain: call law(plant.state_labels) before stepping it")
-        return -(self._gain @ x)
+    def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
+        """``sign K y`` on sensors; on states ``sign K x[states]``, with ``x`` the named states
+        in order or, once :meth:`law` has placed the gain on a plant's states, that plant's
+        state."""
+        if not self.states:
+            return self.gain @ y
+        if self._placed.shape[1] != np.size(x):
+            raise InputError(
+                f"static gain: the plant state has {np.size(x)} entries, the gain "
+                f"{self._placed.shape[1]} columns: call law(plant.state_labels) to place it on "
+                "the plant's states"
+            )
+        return -(self._placed @ x)
 
     def update(self, y: np.ndarray, u: np.ndarray) -> None:
         pass
@@ -179,7 +240,7 @@ def static_gain(
     states: Sequence[str] | None = None,
     sample_rate: float,
     sign: int = -1,
-) -> DiscreteCompensator | StateGain:
+) -> StaticGain:
     """A static output or state feedback ``u = sign K y`` (or ``u = sign K x``); by default
     ``u = -K y``, the LQR convention (``control.lqr``'s K). ``docs/conventions.md``.
 
@@ -199,7 +260,7 @@ def static_gain(
 
     Returns
     -------
-    DiscreteCompensator (no state) or StateGain
+    StaticGain
     """
     if isinstance(sign, bool) or sign not in (1, -1):
         raise InputError(f"sign = {describe(sign)}: expected -1 (u = -K y) or 1 (u = +K y)")
@@ -208,7 +269,7 @@ def static_gain(
         raise InputError("static_gain: give either sensors=[...] or states=[...], not both")
     cols = tuple(check_names("sensors" if states is None else "states", sensors or states))
     try:
-        G = np.atleast_2d(np.asarray(K, dtype=float))
+        G = np.atleast_2d(np.array(K, dtype=float))  # a copy: the caller may change K
     except (TypeError, ValueError):
         raise InputError(f"K = {describe(K)}: expected a real matrix") from None
     if G.shape != (len(controls), len(cols)):
@@ -225,12 +286,8 @@ def static_gain(
         )
     dt = sample_period(sample_rate)
     if states is not None:
-        return StateGain(-sign * G, controls, cols, dt)  # a StateGain is u = -K x
-    z = np.zeros
-    return DiscreteCompensator(
-        z((0, 0)), z((0, len(cols))), z((len(controls), 0)), sign * G, controls, cols, dt,
-        source="static output gain",
-    )  # fmt: skip
+        return StaticGain(G, controls, (), cols, dt, sign)
+    return StaticGain(G, controls, cols, (), dt, sign)
 
 
 @dataclass
@@ -239,7 +296,8 @@ class PythonLaw:
 
     ``fn(t, y)`` (or ``fn(t, y, x)`` with ``needs_state``) returns the commands at time ``t``
     [s] from the sensor values ``y`` (and the plant state ``x``); ``reset()`` (optional) is
-    called before each run. Use :func:`python_law` to build one.
+    called before each run. Built, it is at ``t = 0``: ``command`` works before ``reset``.
+    Use :func:`python_law` to build one.
     """
 
     fn: Callable
@@ -250,6 +308,7 @@ class PythonLaw:
     on_reset: Callable | None = None
     name: str = "Python law"
     is_linear: bool = False
+    _k: int = field(default=0, init=False, repr=False, compare=False)
 
     def reset(self) -> None:
         self._k = 0

@@ -26,14 +26,14 @@ from ..linear.state_space import StateSpaceBuilder
 from ..linear.tags import carry_tags
 from .actuator import actuator_arrays, actuator_labels, actuator_outputs, actuators_of
 from .compensator import compensator_from_lti
+from .gain_schedule import GainSchedule, schedule
 from .hinf import hinf
 from .interface import python_law, static_gain
-from .lqg import lqg
-from .lqr import Bryson, lqr
-from .mpc import mpc
+from .model_predictive import mpc
+from .output_feedback import lqg
 from .plant import OpenLoop, SampledPlant, filter_arrays, state_map, with_sensor_filters
-from .schedule import GainSchedule, schedule
 from .spec import ControllerSpec, check_spec_signals
+from .state_feedback import Bryson, lqr_controller
 
 SAMPLED_CACHE = 96
 """Sampled plants kept per :class:`ControlLoop` (about 80 kB each for a 10-element wing)."""
@@ -256,7 +256,7 @@ class ControlLoop:
         Returns
         -------
         OpenLoop, StateFeedback, OutputFeedback, GainSchedule, MPCController,
-        DiscreteCompensator, StateGain or PythonLaw
+        DiscreteCompensator, StaticGain or PythonLaw
         """
         from .anti_windup import with_anti_windup
 
@@ -312,7 +312,7 @@ class ControlLoop:
 
         def one(v: float):
             if spec.type == "lqr":
-                return lqr(
+                return lqr_controller(
                     self.design(v, filtered=False),
                     self.controls,
                     bryson=self.bryson(spec),

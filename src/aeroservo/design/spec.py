@@ -65,7 +65,7 @@ class ControllerSpec:
         Variance of each sensor [unit^2] (LQG, MPC).
     input_noise : dict
         Loop transfer recovery: fictitious noise variance entering with each control
-        [unit^2] (LQG, MPC; :func:`aeroservo.design.lqg.kalman_filter`).
+        [unit^2] (LQG, MPC; :func:`aeroservo.design.output_feedback.kalman_filter`).
     horizon : int
         MPC horizon [samples].
     solver : str

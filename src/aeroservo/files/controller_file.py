@@ -18,7 +18,7 @@ from pathlib import Path
 from ..design.hinf import HinfWeights
 from ..design.interface import MAX_GAIN
 from ..design.margin_requirement import BREAK_POINT_KEYS, MarginRequirement
-from ..design.mpc import SOLVERS
+from ..design.model_predictive import SOLVERS
 from ..design.plant import Limits
 from ..design.spec import CONTROLLER_TYPES, ControllerSpec
 from ..errors import InputError

@@ -25,6 +25,7 @@ from .._threads import blas_limited
 from ..design.interface import as_controller, controller_at
 from ..design.law import delayed
 from ..design.plant import Limits
+from ..design.protocol import steps_its_law
 from ..design.sampled_loop import linear_law, plant_states
 from ..errors import InputError, check_number
 from ..linear.signals import describe
@@ -106,7 +107,7 @@ def march_hinges(
         dt = check_number("dt", dt, unit="s", lo=1e-6, hi=1.0)
     else:
         controller = controller_at(as_controller(controller, sample_rate=sample_rate), plant.speed)
-        if callable(getattr(controller, "law", None)) and getattr(controller, "is_linear", True):
+        if steps_its_law(controller):
             law = linear_law(controller, plant_states(plant))
             law = delayed(law) if delay else law
         dt = check_number("controller.dt", controller.dt, unit="s", lo=1e-6, hi=1.0)

@@ -18,6 +18,7 @@ from .._threads import blas_limited
 from ..design.interface import as_controller, controller_at
 from ..design.law import delayed
 from ..design.plant import Limits, SampledPlant
+from ..design.protocol import steps_its_law
 from ..design.sampled_loop import linear_law, plant_states
 from ..errors import RANGES, InputError, check_int, check_number
 from ..linear.models import SAMPLE_RATES, check_continuous
@@ -102,7 +103,7 @@ def simulate(
     # a gain schedule: the controller at the plant's speed
     controller = controller_at(controller, float(getattr(plant, "speed", np.nan)))
     law = None
-    if callable(getattr(controller, "law", None)) and getattr(controller, "is_linear", True):
+    if steps_its_law(controller):
         law = linear_law(controller, plant_states(plant))
         law = delayed(law) if delay else law
     lo, hi = SAMPLE_RATES

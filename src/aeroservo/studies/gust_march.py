@@ -127,6 +127,7 @@ class LoopGustMarch:
 
     def __init__(self, sys, controller, limits=None, delay: bool = False, sample_rate=None):
         from ..design.interface import as_controller, controller_at
+        from ..design.protocol import steps_its_law
 
         _gust_column(sys)
         ctrl = as_controller(controller, sample_rate=sample_rate)
@@ -141,7 +142,7 @@ class LoopGustMarch:
         # a linear law with symmetric limits (magnitude +-M, rate +-R) and no noise is an odd
         # loop: the down gust's response is exactly minus the up gust's (IEEE arithmetic
         # commutes with negation), so one sign is marched; a nonlinear law marches both
-        self.odd = callable(getattr(c, "law", None)) and getattr(c, "is_linear", True)
+        self.odd = steps_its_law(c)
 
     def response(self, gradient: float, amplitude: float, duration: float):
         """``(t, y, limited)``: times [s], outputs (n_t, n_outputs) and ``{control: time [s]

@@ -24,9 +24,9 @@ import scipy.linalg as sla
 from .._threads import blas_limited
 from ..errors import InputError, check_number, check_quantity
 from .law import LinearLaw
-from .lqr import Bryson, _balanced_lqr, cost_weights
 from .plant import SampledPlant, select
 from .riccati import solve_dare
+from .state_feedback import Bryson, _balanced_lqr, cost_weights
 
 __all__ = ["KalmanFilter", "kalman_filter", "OutputFeedback", "lqg", "estimator_law"]
 
@@ -204,7 +204,7 @@ def lqg(
     input_noise : dict, optional
         Loop transfer recovery at the plant input, see :func:`kalman_filter`.
     Q, R, bryson :
-        LQR weights, see :func:`aeroservo.design.lqr.lqr`.
+        LQR weights, see :func:`aeroservo.design.state_feedback.lqr_controller`.
     sample_rate : float
         [Hz].
 

@@ -18,15 +18,17 @@ import numpy as np
 
 from ..errors import InputError
 from .closed_loop import speeds_grid
-from .lqg import KalmanFilter, OutputFeedback
-from .lqr import StateFeedback
+from .output_feedback import KalmanFilter, OutputFeedback
+from .state_feedback import StateFeedback
 
 __all__ = ["GainSchedule", "schedule"]
 
 
 @dataclass
 class GainSchedule:
-    """Linear controllers on a speed grid, interpolated linearly in speed.
+    """Linear controllers on a speed grid, interpolated linearly in speed (a
+    :class:`~aeroservo.design.protocol.ScheduledController`: every engine takes the controller
+    :meth:`at` the plant's speed).
 
     Attributes
     ----------
@@ -108,7 +110,7 @@ def schedule(
     Parameters
     ----------
     design : callable
-        ``design(V)`` returns an LQR (:func:`~aeroservo.design.lqr`) or LQG
+        ``design(V)`` returns an LQR (:func:`~aeroservo.design.lqr_controller`) or LQG
         (:func:`~aeroservo.design.lqg`) controller designed on the model at speed V [m/s].
     speeds : sequence of float
         Increasing design speeds [m/s].

@@ -1,7 +1,7 @@
 """Constrained linear MPC for flutter suppression, solved as a QP with casadi.
 
 At each sample the state of the (reduced) design model is estimated by the Kalman filter of
-:mod:`aeroservo.design.lqg`, then the condensed quadratic program
+:mod:`aeroservo.design.output_feedback`, then the condensed quadratic program
 
 ``min_U  sum_{k=0}^{N-1} (x_k'Q x_k + 2 x_k'N u_k + u_k'R u_k) + x_N'P x_N + w_s |S|^2``
 
@@ -27,10 +27,10 @@ from .._c_stdout import c_stdout_silenced
 from .._threads import blas_limited
 from ..errors import InputError, check_int, check_number, check_quantity
 from .law import LinearLaw
-from .lqg import KalmanFilter, estimator_law, kalman_filter
-from .lqr import Bryson, cost_weights
+from .output_feedback import KalmanFilter, estimator_law, kalman_filter
 from .plant import Limits, SampledPlant, select
 from .riccati import solve_dare
+from .state_feedback import Bryson, cost_weights
 
 __all__ = ["MPCController", "mpc", "SOLVERS"]
 
@@ -55,7 +55,8 @@ returned."""
 
 @dataclass
 class MPCController:
-    """Sampled MPC controller (use :func:`mpc` to build one).
+    """Sampled MPC controller (use :func:`mpc` to build one; built with its solver, it is
+    ready to use: ``command`` works before ``reset``).
 
     Attributes
     ----------
@@ -92,6 +93,10 @@ class MPCController:
     solve_times: list = field(default_factory=list)
     statuses: list = field(default_factory=list)
     fallbacks: int = 0
+
+    def __post_init__(self) -> None:
+        if self.solver is not None:  # built ready to use: the solver's buffers bound
+            self.reset()
 
     def reset(self) -> None:
         self.kf.reset()
@@ -279,13 +284,14 @@ def mpc(
     limits : Limits
         Hard magnitude and rate limits of every control (both are required).
     process_noise, sensor_noise : dict
-        Kalman filter noise variances (see :func:`aeroservo.design.lqg.kalman_filter`).
+        Kalman filter noise variances (see :func:`aeroservo.design.output_feedback.kalman_filter`).
     input_noise : dict, optional
-        Loop transfer recovery at the plant input (:func:`aeroservo.design.lqg.kalman_filter`).
+        Loop transfer recovery at the plant input
+        (:func:`aeroservo.design.output_feedback.kalman_filter`).
     horizon : int
         Prediction horizon N [samples].
     bryson, Q, R :
-        Stage cost weights (see :func:`aeroservo.design.lqr.lqr`).
+        Stage cost weights (see :func:`aeroservo.design.state_feedback.lqr_controller`).
     soft_outputs : dict, optional
         ``{output name: limit}`` soft limits on outputs without direct feedthrough.
     slack_weight : float
@@ -362,7 +368,7 @@ def mpc(
             {"h": ca.DM(H_full).sparsity(), "a": ca.DM(A_con).sparsity()},
             SOLVERS[solver],
         )
-    ctrl = MPCController(
+    return MPCController(
         horizon=horizon,
         controls=tuple(controls),
         sensors=tuple(sensors),
@@ -380,5 +386,3 @@ def mpc(
         solver_name=solver,
         solver=conic,
     )
-    ctrl.reset()
-    return ctrl

@@ -1,5 +1,8 @@
 """Linear-quadratic regulator (full-state feedback) with Bryson's-rule weights.
 
+:func:`lqr_controller` designs the sampled controller, a :class:`StateFeedback`. It is not named
+``lqr``: ``control.lqr`` returns the matrices ``(K, S, E)``, and a function named like one of
+python-control's returns what that one returns (``lqr`` stays one release, deprecated).
 ``control.lqr`` gives the continuous gain (used for closed-loop flutter boundaries and Bode
 analysis) and ``control.dlqr`` the gain for the sampled loop, on the exact zero-order-hold model
 with the same weights.
@@ -7,6 +10,7 @@ with the same weights.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -23,7 +27,7 @@ from .plant import SampledPlant, select
 BRYSON_RANGE = (RANGES["bryson"].lo, RANGES["bryson"].hi)
 """Allowed values of Bryson's limits [signal units] (their inverse squares stay finite)."""
 
-__all__ = ["Bryson", "bryson_weights", "cost_weights", "StateFeedback", "lqr"]
+__all__ = ["Bryson", "bryson_weights", "cost_weights", "StateFeedback", "lqr_controller", "lqr"]
 
 
 @dataclass(frozen=True)
@@ -216,7 +220,7 @@ def _balanced_lqr(solver, A, B, Q, R, N) -> tuple[np.ndarray, np.ndarray]:
 
 
 @blas_limited
-def lqr(
+def lqr_controller(
     sys,
     controls: Sequence[str],
     *,
@@ -226,7 +230,12 @@ def lqr(
     sample_rate: float = 1000.0,
     state_map: np.ndarray | None = None,
 ) -> StateFeedback:
-    """Full-state-feedback LQR on a design model.
+    """Full-state-feedback LQR controller designed on a design model.
+
+    Unlike ``control.lqr``, which returns the gain, the Riccati solution and the closed-loop
+    eigenvalues ``(K, S, E)``, this returns the sampled controller: its gains are
+    ``StateFeedback.K`` (continuous, ``control.lqr``'s K) and ``StateFeedback.Kd`` (sampled
+    loop, ``control.dlqr``'s), its closed-loop poles ``StateFeedback.closed_loop_poles``.
 
     Parameters
     ----------
@@ -285,3 +294,16 @@ def _state_map(value, n: int) -> np.ndarray:
     if not np.all(np.isfinite(T)):
         raise InputError("lqr: state_map has NaN or infinite entries")
     return T.astype(float)
+
+
+def lqr(*args, **kwargs) -> StateFeedback:
+    """Deprecated name of :func:`lqr_controller` (``control.lqr`` of the same name returns
+    ``(K, S, E)``, this a controller); it warns and calls :func:`lqr_controller`."""
+    warnings.warn(
+        "aeroservo.design.lqr is deprecated and will be removed in the next release: use "
+        "aeroservo.design.lqr_controller (control.lqr of the same name returns (K, S, E), this "
+        "returns a StateFeedback controller)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return lqr_controller(*args, **kwargs)
