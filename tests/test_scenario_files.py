@@ -27,6 +27,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from aeroservo.design.spec import CONTROLLER_TYPES
 from aeroservo.errors import InputError
 from aeroservo.files import load_controller, load_scenario
 from aeroservo.files.controller_file import controller_from_dict
@@ -110,7 +111,7 @@ def test_shipped_scenario_loads(name):
 @pytest.mark.parametrize("name", SHIPPED_CONTROLLERS)
 def test_shipped_controller_loads(name):
     spec = load_controller(CONTROLLERS / name)
-    assert spec.type in ("none", "lqr", "lqg", "mpc", "hinf")
+    assert spec.type in CONTROLLER_TYPES
 
 
 # -- fuzzing: strategies ----------------------------------------------------------------------

@@ -29,7 +29,8 @@ __all__ = ["dlm_terms"]
 def dlm_terms(
     model, rho: float, mach: float, n_modes: int | None, has_gust: bool, gust: str
 ) -> AeroTerms:
-    """Doublet-lattice terms (:func:`aeroservo.linear.aero_terms.aero_terms`)."""
+    """Doublet-lattice terms (:class:`aeroservo.linear.aero_terms.AeroTerms`; the strip-theory
+    ones: :func:`aeroservo.linear.aero_terms.strip_terms`)."""
     dlm = model.dlm
     if gust != "kussner":
         raise InputError(

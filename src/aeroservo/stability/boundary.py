@@ -123,7 +123,7 @@ def flutter_boundary(
         imaginary axis are; the others are the modal model's, to about 1e-3).
     mach : float
         Mach number of the Prandtl-Glauert correction (0: incompressible), fixed over the
-        sweep; :func:`aeroservo.stability.matched.flutter_at_altitude` finds the matched point.
+        sweep; :func:`aeroservo.stability.matched.flutter_at` finds the matched point.
 
     Returns
     -------
