@@ -154,7 +154,6 @@ FLUTTER_MODULES = {
             ".envelope",
             ".importing",
             ".lco",
-            ".loads",
             ".options",
             ".optimize",
             ".results",
@@ -186,6 +185,8 @@ FLUTTER_MODULES = {
     ),
     "aeroservo.studies",
     "aeroservo.studies.flight_condition",
+    "aeroservo.studies.kinds",  # the registry of scenario kinds: the scenario commands' parsers
+    "aeroservo.studies.study_options",
     *(
         f"aeroservo.structure{m}"
         for m in ("", ".beam_element", ".examples", ".masses", ".mesh", ".wing")

@@ -563,12 +563,12 @@ def test_docs_match_the_code(tmp_path):
         "dt": "s",
         "history": "s",
     }
-    assert (c["duration"], c["dt"], c["settle"]) == (30.0, 0.001, 0.5)
+    assert (c.duration, c.dt, c.settle) == (30.0, 0.001, 0.5)
     assert (lco["duration"][1], lco["dt"][1], lco["settle"][1]) == ("30", "0.001", "0.5")
-    assert c["continuation"] is True and lco["continuation"][1] == "true"
-    assert c["describing"] is True and lco["describing"][1] == "true"
-    assert c["workers"] == 0 and lco["workers"][1] == "0"
-    assert c["history"] == 2.0 and lco["history"][1] == "min(2, duration)"
+    assert c.continuation is True and lco["continuation"][1] == "true"
+    assert c.describing is True and lco["describing"][1] == "true"
+    assert c.workers == 0 and lco["workers"][1] == "0"
+    assert c.history == 2.0 and lco["history"][1] == "min(2, duration)"
     # [section]: every parameter and its unit as the code names them
     sec = _doc_table("**The model.**")
     assert set(sec) == set(SECTION_KEYS) | {"builtin", "damped"}

@@ -17,7 +17,9 @@ def solve_dare(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np
     Structured doubling algorithm (Chu, Fan, Lin & Wang 2004): quadratically convergent, no
     eigenvalue reordering, hence robust for the many lightly damped structural poles close to the
     unit circle that defeat Schur/QZ-based solvers here. Solved in coordinates equilibrated by a
-    diagonal similarity; the residual is checked.
+    diagonal similarity; the residual is checked, and that ``A - B K`` has every eigenvalue
+    inside the unit circle (a non-stabilisable pair raises :class:`NumericalError` rather
+    than returning a huge X).
     """
     n = A.shape[0]
     _, (t, _) = sla.matrix_balance(A, permute=False, separate=True)
@@ -44,6 +46,17 @@ def solve_dare(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np
     corr = A0.T @ Xb @ Bt @ np.linalg.solve(S, Bt.T @ Xb @ A0)
     res = axa - corr + Q0 - Xb
     scale = np.linalg.norm(axa) + np.linalg.norm(corr) + np.linalg.norm(Q0) + np.linalg.norm(Xb)
-    if not np.linalg.norm(res) <= 1e-8 * scale:
-        raise NumericalError("discrete Riccati equation: the doubling iteration did not converge")
+    if not (np.all(np.isfinite(Xb)) and np.linalg.norm(res) <= 1e-8 * scale):
+        raise NumericalError(
+            "discrete Riccati equation: the doubling iteration did not converge (no stabilising "
+            "solution: is the pair (A, B) stabilisable?)"
+        )
+    # the stabilising solution: A - B K has every eigenvalue inside the unit circle (lightly
+    # damped modes the gain cannot reach stay just inside; a root outside is no solution)
+    rho = np.abs(np.linalg.eigvals(A0 - Bt @ np.linalg.solve(S, Bt.T @ Xb @ A0))).max()
+    if not rho <= 1.0 + 1e-8:
+        raise NumericalError(
+            f"discrete Riccati equation: no stabilising solution (closed-loop spectral radius "
+            f"{rho:.6g} > 1: the pair (A, B) is not stabilisable)"
+        )
     return Xb / t[:, None] / t[None, :]

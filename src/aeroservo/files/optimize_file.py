@@ -192,7 +192,7 @@ def load_codesign(path: str | Path) -> CoDesignFile:
         cd = top.table("codesign").check_keys(("scenario",), ("name",))
         sc_path = cd.path("scenario", Path(file).parent, required=True)
         scenario = load_scenario(sc_path)
-        if scenario.kind != "trade":
+        if scenario.trade is None:
             cd.fail("scenario", cd.data["scenario"], f"a trade scenario, not {scenario.kind!r}")
         start = {k: top.table("start").number(k) for k in top.table("start").data}
         variables = _bounds(top)

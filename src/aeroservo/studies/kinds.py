@@ -14,11 +14,14 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .._threads import blas_limited
 from ..errors import InputError
-from .scenario import Scenario
 from .study_options import GustLoadsOptions, LCOOptions, TradeOptions
+
+if TYPE_CHECKING:  # the registry stays light: the command line reads it to build its parser
+    from .scenario import Scenario
 
 __all__ = ["Run", "ScenarioKind", "KINDS", "scenario_kind", "check_kind", "run_scenario"]
 
