@@ -1,7 +1,7 @@
 """The ``lco`` command: limit-cycle oscillations of an ``lco`` scenario (a wing or a typical
 section with nonlinear hinges, open or closed loop) over its speeds and initial rotations (in
-this process or on Dask), written as one set of files; and the redrawing of a saved result
-(``aeroservo plot RESULT.json``)."""
+this process or on Dask), written as one set of files (``aeroservo plot RESULT.json`` redraws
+its figures: ``LCOResult.plot``)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from ..errors import InputError
 from .aero_options import add_aero_options, load_scenario_with
 from .loads import _workers
 
-__all__ = ["add_parsers", "HANDLERS", "run_lco_loaded", "plot_saved", "LCO_KINDS"]
+__all__ = ["add_parsers", "HANDLERS", "run_lco_loaded", "LCO_KINDS"]
 
 LCO_KINDS = ("bifurcation", "histories")
 """The figures of a saved limit-cycle result (``aeroservo plot --kind``)."""
@@ -82,30 +82,7 @@ def run_lco_loaded(scenario, args: argparse.Namespace) -> int:
         )
     if workers is not None and not 0 <= workers <= 256:
         raise InputError(f"--workers = {workers}: allowed range is [0, 256]")
-    return run_study(scenario, args, lambda run: run.lco.summary_text())
-
-
-def plot_saved(res, src, args: argparse.Namespace, kind: str) -> int:
-    """The figures of a saved limit-cycle result: the bifurcation diagram and, when its NPZ
-    was next to it, the time histories, next to the result (as ``aeroservo lco`` names
-    them); or ``--kind`` alone (to ``--out``)."""
-    from pathlib import Path
-
-    from ..atomic import save_figure
-    from ..studies.lco_scenario import lco_figures
-
-    which = LCO_KINDS if args.kind is None and args.out is None else (kind,)
-    figs = lco_figures(res, which)
-    if not figs:
-        raise InputError(
-            f"--kind = {kind!r}: {args.result} has no time histories (its "
-            f"{Path(args.result).stem}_histories.npz is not next to it)"
-        )
-    for name, fig in figs.items():
-        out = Path(args.out) if args.out else src.with_name(f"{src.stem}_{name}.png")
-        save_figure(fig, out, dpi=130)
-        print(f"plot written to {out}")
-    return 0
+    return run_study(scenario, args, lambda run: run.lco.summary())
 
 
 HANDLERS = {"lco": _cmd_lco}

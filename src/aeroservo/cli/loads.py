@@ -72,7 +72,7 @@ def run_loaded(scenario, args: argparse.Namespace) -> int:
     its files and print its summary."""
     from .options import run_study
 
-    return run_study(scenario, args, lambda run: run.loads.summary_text())
+    return run_study(scenario, args, lambda run: run.loads.summary())
 
 
 HANDLERS = {"loads": _cmd_loads}
