@@ -24,6 +24,7 @@ BASE = (
     "aeroservo._c_stdout",
     "aeroservo._lazy",
     "aeroservo._figures",
+    "aeroservo.result_shape",
 )
 ORDER = [
     "base",

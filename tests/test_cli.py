@@ -131,6 +131,7 @@ FLUTTER_MODULES = {
     "aeroservo._threads",
     "aeroservo._version",
     "aeroservo.errors",
+    "aeroservo.result_shape",  # the shape of every result (issue 39): no numpy at import
     *(
         f"aeroservo.aero{m}"
         for m in (

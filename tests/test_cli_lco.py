@@ -149,7 +149,7 @@ def test_files_read_back_equal(cli_run):
     doc = json.loads((out / f"{STEM}.json").read_text(), parse_constant=_no_constant)
     assert _same([{k: v for k, v in r.items() if k != "history"} for r in res.rows], doc["rows"])
     assert _same(res.branches.table(), doc["branches"]["table"])
-    assert res.summary_text() == doc["summary_text"]
+    assert res.summary() == doc["summary_text"]
     csv = (out / f"{STEM}.csv").read_text().splitlines()[1:]
     assert len(csv) == len(res.rows)
     first = dict(zip(TABLE_COLUMNS, csv[0].split(","), strict=False))
@@ -174,12 +174,12 @@ def test_round_trip_is_equal(tmp_path):
     back = load_lco(tmp_path / "r.json")
     assert _same(back.rows, res.rows) and back.branches is None
     assert back.settings == json.loads(json.dumps(res.settings))
-    assert back.table() == res.table() or _same(back.table(), res.table())
-    assert back.summary_text() == res.summary_text()
+    assert back.table_rows() == res.table_rows() or _same(back.table_rows(), res.table_rows())
+    assert back.summary() == res.summary()
     # without the NPZ: the verdicts without histories
     (tmp_path / "r_histories.npz").unlink()
     bare = load_lco(tmp_path / "r.json")
-    assert all(r["history"] == {} for r in bare.rows) and _same(bare.table(), res.table())
+    assert all(r["history"] == {} for r in bare.rows) and _same(bare.table_rows(), res.table_rows())
     with pytest.raises(InputError, match="expected a .json file name"):
         write_lco(res, tmp_path / "r.npz")
     (tmp_path / "other.json").write_text('{"format": "aeroservo-gust-loads-2"}')

@@ -153,7 +153,7 @@ def test_round_trip_is_equal(api_run, tmp_path):
         assert back.arrays[k].dtype == v.dtype
         np.testing.assert_array_equal(back.arrays[k], v)
     pd.testing.assert_frame_equal(back.table, res.table)
-    assert back.summary_text() == res.summary_text()
+    assert back.summary() == res.summary()
     t, gust, y = back.history(0, "closed", "root_bending_moment")
     t0, gust0, y0 = res.history(0, "closed", "root_bending_moment")
     np.testing.assert_array_equal(t, t0)
@@ -406,7 +406,7 @@ def test_open_loop_scenario_with_mass_cases(tmp_path, capsys):
     a = recs["nominal"]["loads"]["root_torque"]["discrete"]
     b = recs["store"]["loads"]["root_torque"]["discrete"]
     assert not np.isclose(a, b, rtol=1e-3)
-    assert re.search(r"store 1000 m V_C 90 m/s EAS", back.summary_text())
+    assert re.search(r"store 1000 m V_C 90 m/s EAS", back.summary())
     # issue 40: an open-loop result re-plots in every kind it has (its alleviation raises, and
     # hasattr on it used to crash the command); the spanwise kind says what it needs
     for kind in ("envelope", "correlated", "critical-gusts"):

@@ -190,7 +190,7 @@ def test_a_point_without_any_loop_is_kept_with_its_reasons():
     assert {r["point"] for r in res.records} == {0}  # the closed loop is unstable at 100 too
     [sk] = res.settings["skipped_points"]
     assert sk["point"] == 1 and any("open loop unstable" in n for n in sk["notes"])
-    text = res.summary_text()
+    text = res.summary()
     assert "NO LOADS at point 1" in text
     assert text.count("closed loop at 100 m/s TAS is unstable") == 1  # one note per point
 
@@ -230,7 +230,7 @@ def test_swept_wing_under_strip_gusts_says_the_spanwise_delay_is_missing():
     )
     (w,) = res.settings["warnings"]
     assert w.startswith("mass case swept: a swept wing") and "spanwise delay" in w
-    assert f"WARNING: {w}" in res.summary_text()
+    assert f"WARNING: {w}" in res.summary()
     straight = run_gust_loads(_study(controller=None, controls=(), sensors=()))
     assert straight.settings["warnings"] == []
 

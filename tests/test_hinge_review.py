@@ -585,7 +585,7 @@ def test_growing_is_a_moderate_divergence(study):
 def test_summary_numbers_are_the_rows(study):
     """The summary's limit-cycle range, amplitudes per gap, frequencies, divergence speed and
     the describing-function comparison are computed from the rows (and the branches)."""
-    text = study.summary_text()
+    text = study.summary()
     lco = study.lco_rows()
     assert lco
     v = [r["speed"] for r in lco]

@@ -113,6 +113,6 @@ def test_continuation_sweeps_and_the_summary():
     point = next(r for r in res.rows if r["start"] == "point" and r["speed"] == 10.0
                  and r["initial"] == 2.0 * GAP)  # fmt: skip
     assert down[1]["amplitude"] == pytest.approx(point["amplitude"], rel=1e-12)
-    text = res.summary_text()
+    text = res.summary()
     assert "limit cycles from 10 to 10 m/s" in text
     assert "divergent motion from 26 m/s" in text

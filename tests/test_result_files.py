@@ -314,7 +314,7 @@ def test_simulation_results_still_load(tmp_path):
         pass
     with pytest.raises(aes.InputError, match="no JSON header"):
         aes.load_result(tmp_path / "empty.npz")
-    with pytest.raises(aes.InputError, match="expected a SimulationResult or a FlutterResult"):
+    with pytest.raises(aes.InputError, match="result = object: not an aeroservo result"):
         aes.save_result(object(), tmp_path / "x.npz")
 
 

@@ -80,7 +80,8 @@ def test_simulation_summary_and_result_roundtrip(tmp_path):
     )
     assert back.limits == res.limits and back.units == res.units and back.speed == res.speed
     assert (
-        back.summary["closed_loop"]["closed_loop_flutter_speed"] == cl["closed_loop_flutter_speed"]
+        back.run_summary["closed_loop"]["closed_loop_flutter_speed"]
+        == cl["closed_loop_flutter_speed"]
     )
     assert summary["signals"]["tip_disp"]["peak"] == pytest.approx(0.01)
     on_disk = json.loads((tmp_path / "goland_aileron_lqr.json").read_text())

@@ -9,6 +9,7 @@ from __future__ import annotations
 from ._lazy import lazy_attributes
 from ._version import __version__
 from .errors import AeroservoError, InputError, NumericalError, VerdictFailure
+from .result_shape import use_shell as _use_shell
 
 _PUBLIC = {
     "Freeplay": "structure.hinge_laws",
@@ -82,3 +83,25 @@ __all__ = [
 
 
 __getattr__, __dir__ = lazy_attributes(__name__, _PUBLIC, _SUBPACKAGES)
+
+
+def _shell(name: str):
+    """The functions of the upper stages that results use (:mod:`aeroservo.result_shape`):
+    the one writer of result files and the figures ``plots/`` draws of results below it,
+    imported when first asked for."""
+    if name == "save_result":
+        from .files.results import save_result
+
+        return save_result
+    if name in ("plot_vg", "plot_root_locus"):
+        from .plots import flutter
+
+        return getattr(flutter, name)
+    if name in ("plot_loop_margins", "plot_margin_sweep"):
+        from .plots import margins
+
+        return getattr(margins, name)
+    raise KeyError(name)
+
+
+_use_shell(_shell)

@@ -5,14 +5,16 @@ from __future__ import annotations
 
 import argparse
 
-from .lco import LCO_KINDS
 from .options import add_flight_options, add_model_options, positive_float, quantity
 
 __all__ = ["add_parsers", "HANDLERS"]
 
 FLUTTER_KINDS = ("vg", "vf", "root-locus", "modes", "flutter-mode")
 GUST_KINDS = ("envelope", "correlated", "critical-gusts", "spanwise")
+LCO_KINDS = ("bifurcation", "histories")
 KINDS = (*FLUTTER_KINDS, "time", "pareto", "heatmap", "envelope", *GUST_KINDS[1:], *LCO_KINDS)
+KINDS += ("boundary", "margins", "margin-sweep", "recovery")
+"""Every result's figures (``result.FIGURES``; ``aeroservo plot --kind``)."""
 
 
 def _mode_list(text: str) -> list[int]:
@@ -43,8 +45,11 @@ def add_parsers(sub) -> None:
         "(time), a trade study's folder (pareto, heatmap: --metric and --slice choose the "
         "metric and the other parameters' values) or an envelope saved by 'aeroservo envelope "
         "--save' (envelope), gust loads written by 'aeroservo loads' (RESULT.json: envelope, "
-        "correlated, critical-gusts) or limit cycles written by 'aeroservo lco' (RESULT.json: "
-        "bifurcation, histories); all of a result's figures without --kind and --out.",
+        "correlated, critical-gusts, spanwise) or limit cycles written by 'aeroservo lco' "
+        "(RESULT.json: bifurcation, histories); all of a result's figures without --kind and "
+        "--out. Any result saved by its save() method (Python) redraws too: a closed-loop "
+        "boundary (boundary), loop margins (margins), a margin sweep (margin-sweep), a "
+        "recoverable set (recovery).",
     )
     pl.add_argument(
         "result", help="result file (.npz, envelope, gust-loads or lco .json) or trade folder"
@@ -98,6 +103,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
     from ..atomic import save_figure
     from ..errors import InputError
+    from ..files.results import load_result
     from ..files.user_files import check_readable
     from .options import check_figure
 
@@ -116,8 +122,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         from ..atomic import check_output_path
 
         check_output_path(out, "--out")
-    res = _load(src)
-    what, kinds = _what(res)
+    res = load_result(src)
+    what, kinds = _what(res), tuple(res.FIGURES)
     heat = args.metric is not None or args.slice is not None
     kind = args.kind or ("heatmap" if heat and "heatmap" in kinds else kinds[0])
     if heat and kind != "heatmap":
@@ -130,23 +136,53 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         return _animate_saved(res, args, out)
     if what != "a flutter sweep" and (args.fmax or args.modes or args.eas):
         raise InputError(f"--fmax, --modes and --eas apply to flutter sweeps, not to {what}")
-    if kinds == GUST_KINDS:
-        return _gust_figures(res, src, args, kind)
-    if kinds == LCO_KINDS:
-        from .lco import plot_saved
-
-        return plot_saved(res, src, args, kind)
-    if kind in FLUTTER_KINDS:
-        fig = _flutter_figure(res, kind, args)
-    elif kind == "time":
-        fig = res.plot()
-    elif kind == "envelope":
-        fig = res.plot(units=args.units)
-    else:
-        fig = res.pareto() if kind == "pareto" else _heatmap(res, args)
-    save_figure(fig, out, dpi=130)
-    print(f"plot written to {out}")
+    several = what in ("gust loads", "limit cycles")  # named <stem>_<kind>.png
+    which = res.figure_kinds if several and args.kind is None and args.out is None else (kind,)
+    if kind not in res.figure_kinds:
+        raise InputError(_missing(res, src, args, kind))
+    for k in which:
+        fig = res.plot(k, **_options(res, k, args))
+        name = k.replace("-", "_")
+        path = out if args.out or not several else src.with_name(f"{src.stem}_{name}.png")
+        save_figure(fig, path, dpi=130)
+        print(f"plot written to {path}")
     return 0
+
+
+def _options(res, kind: str, args: argparse.Namespace) -> dict:
+    """The options of ``res.plot(kind, ...)`` the command's arguments give."""
+    if kind in ("vg", "vf"):
+        fmax = args.fmax or "auto"
+        return dict(units=args.units, eas=args.eas, fmax=fmax, modes=args.modes,
+                    g_required=args.g_required)  # fmt: skip
+    if kind == "root-locus":
+        return dict(fmax=args.fmax, modes=args.modes, units=args.units)
+    if kind == "modes":
+        return dict(fmax=args.fmax, modes=args.modes)
+    if kind == "envelope" and _what(res) == "a flutter envelope":
+        return dict(units=args.units)
+    if kind == "heatmap":
+        return _heatmap(res, args)
+    return {}
+
+
+def _missing(res, src, args: argparse.Namespace, kind: str) -> str:
+    """Why ``res`` cannot draw ``kind`` (one line)."""
+    if kind == "histories":
+        return (
+            f"--kind = {kind!r}: {args.result} has no time histories (its "
+            f"{src.stem}_histories.npz is not next to it)"
+        )
+    if kind in ("correlated", "spanwise"):
+        need = (
+            "loads at two or more stations (root loads, load_stations)"
+            if kind == "spanwise"
+            else "both root_bending_moment and root_torque as loads"
+        )
+        return f"--kind = {kind!r}: {args.result} has not {need}"
+    if not res.modes:
+        return f"{args.result}: the file has no mode shapes"
+    return f"{args.result}: no flutter in the sweep, so no flutter mode"
 
 
 def _animate_saved(saved, args: argparse.Namespace, out) -> int:
@@ -178,9 +214,9 @@ def _animate_saved(saved, args: argparse.Namespace, out) -> int:
     return 0
 
 
-def _heatmap(res, args: argparse.Namespace):
-    """A trade study's heat map of ``--metric`` on ``--slice`` (one-line errors that list the
-    valid names and values)."""
+def _heatmap(res, args: argparse.Namespace) -> dict:
+    """The options of a trade study's heat map of ``--metric`` on ``--slice`` (one-line errors
+    that list the valid names and values)."""
     from ..errors import InputError
     from ..studies.trade.study import METRICS
 
@@ -195,7 +231,7 @@ def _heatmap(res, args: argparse.Namespace):
             f"--slice = {args.slice!r}: a heat map needs two parameters left free; this study "
             f"sweeps {', '.join(res.parameters)}"
         )
-    return res.heatmap(args.metric, **fixed)
+    return {"metric": args.metric, **fixed}
 
 
 def _slice(text: str, parameters: dict) -> dict:
@@ -233,102 +269,23 @@ def _slice(text: str, parameters: dict) -> dict:
     return out
 
 
-def _load(src):
-    """A saved result: gust loads (:func:`~aeroservo.files.gust_loads_file.load_gust_loads`)
-    or any other (:func:`~aeroservo.files.results.load_result`)."""
-    from ..files.gust_loads_file import is_gust_loads_file, load_gust_loads
-    from ..files.results import load_result
-
-    return load_gust_loads(src) if is_gust_loads_file(src) else load_result(src)
-
-
-def _gust_figures(res, src, args: argparse.Namespace, kind: str) -> int:
-    """The figures of saved gust loads: all of them next to the result (as ``aeroservo loads``
-    names them), or ``--kind`` alone (to ``--out``)."""
-    from pathlib import Path
-
-    from ..atomic import save_figure
-    from ..errors import InputError
-    from ..studies.gust_scenario import FIGURES, gust_figures
-
-    which = FIGURES if args.kind is None and args.out is None else (kind.replace("-", "_"),)
-    figs = gust_figures(res, which)
-    if not figs:
-        need = (
-            "loads at two or more stations (root loads, load_stations)"
-            if kind == "spanwise"
-            else "both root_bending_moment and root_torque as loads"
-        )
-        raise InputError(f"--kind = {kind!r}: {args.result} has not {need}")
-    for name, fig in figs.items():
-        out = Path(args.out) if args.out else src.with_name(f"{src.stem}_{name}.png")
-        save_figure(fig, out, dpi=130)
-        print(f"plot written to {out}")
-    return 0
+_WHAT = {
+    "GustLoadsResult": "gust loads",
+    "LCOResult": "limit cycles",
+    "SavedFlutter": "a flutter sweep",
+    "TradeResult": "a trade study",
+    "Envelope": "a flutter envelope",
+    "SimulationResult": "a simulation",
+    "ClosedLoopBoundary": "a closed-loop boundary",
+    "LoopMargins": "loop margins",
+    "MarginSweep": "a margin sweep",
+    "RecoverableSet": "a recoverable set",
+}
 
 
-def _what(res) -> tuple[str, tuple]:
-    """What a loaded result is, and the figure kinds it has (default first)."""
-    from ..studies.gust_results import GustLoadsResult
-
-    if isinstance(res, GustLoadsResult):  # not hasattr: an open-loop result's alleviation raises
-        return "gust loads", GUST_KINDS
-    if hasattr(res, "hysteresis"):
-        return "limit cycles", LCO_KINDS
-    if hasattr(res, "pk"):
-        return "a flutter sweep", FLUTTER_KINDS
-    if hasattr(res, "pareto"):
-        return "a trade study", ("pareto", "heatmap")
-    if hasattr(res, "margin_ok"):
-        return "a flutter envelope", ("envelope",)
-    return "a simulation", ("time",)
-
-
-def _flutter_figure(saved, kind: str, args: argparse.Namespace):
-    from ..errors import InputError
-    from ..plots.flutter import plot_root_locus, plot_vg, select_modes
-    from ..plots.modes import plot_modes
-
-    r, title = saved.result, saved.meta.get("title") or None
-    if kind in ("vg", "vf"):
-        fig = plot_vg(
-            r,
-            title=title,
-            units=args.units,
-            eas=args.eas,
-            fmax=args.fmax or "auto",
-            modes=args.modes,
-            pk=saved.pk,
-            g_required=args.g_required,
-        )
-        if kind == "vf":  # the frequency panel alone
-            ax_f, ax_g = fig.axes[:2]
-            fig.delaxes(ax_g)
-            ax_f.set_xlabel(ax_g.get_xlabel())
-            ax_f.tick_params(labelbottom=True)
-        return fig
-    if kind == "root-locus":
-        return plot_root_locus(r, title=title, fmax=args.fmax, modes=args.modes, units=args.units)
-    if not saved.modes:
-        raise InputError(f"{args.result}: the file has no mode shapes")
-    if kind == "modes":
-        freqs = saved.modes["frequency"]
-        cols = [j for j in select_modes(r, args.fmax, args.modes) if j < freqs.size]
-        return plot_modes(
-            saved.modes,
-            saved.modes["label"],
-            freqs,
-            surfaces=saved.surfaces,
-            modes=cols,
-            title=title,
-        )
-    if saved.flutter_mode is None or r.flutter is None:
-        raise InputError(f"{args.result}: no flutter in the sweep, so no flutter mode")
-    fields = dict(saved.flutter_mode)
-    fields = {k: (v if k == "x" else v[:, None]) for k, v in fields.items()}
-    fl = r.flutter
-    label = f"flutter mode ({r.mode_labels[fl.mode]}) at {fl.speed:.4g} m/s"
-    return plot_modes(fields, [label], [fl.frequency], surfaces=saved.surfaces, title=title)
+def _what(res) -> str:
+    """What a loaded result is, for messages."""
+    return _WHAT.get(type(res).__name__, f"a {type(res).__name__}")
 
 
 def _cmd_export(args: argparse.Namespace) -> int:

@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..result_shape import Result
+
 __all__ = ["ClosedLoopBoundary", "loss_name"]
 
 
@@ -20,8 +22,12 @@ def loss_name(static: bool, frequency: float | None) -> str:
 
 
 @dataclass
-class ClosedLoopBoundary:
+class ClosedLoopBoundary(Result):
     """Closed-loop stability of a linear controller versus airspeed.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (the grid), :meth:`plot` (``"boundary"``), :meth:`to_json` and :meth:`save`
+    (a ``.npz``).
 
     Attributes
     ----------
@@ -57,6 +63,8 @@ class ClosedLoopBoundary:
     info: dict = field(default_factory=dict)
     delay: bool = False
     reference_abscissa: float | None = None
+
+    FIGURES = {"boundary": "plot_boundary"}
 
     @property
     def v_range(self) -> tuple[float, float]:
@@ -200,7 +208,55 @@ class ClosedLoopBoundary:
             "v_range": list(self.v_range),
         }
 
-    def plot(
+    @property
+    def table(self):
+        """The speed grid (pandas DataFrame): ``speed_m_s``, ``growth_rate_1_s`` (of the least
+        stable closed-loop pole), ``frequency_hz`` (of that pole) and ``stable``."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "speed_m_s": np.asarray(self.speeds, dtype=float),
+                "growth_rate_1_s": np.asarray(self.abscissa, dtype=float),
+                "frequency_hz": np.asarray(self.frequencies, dtype=float),
+                "stable": np.asarray(self.abscissa) < 0,
+            }
+        )
+
+    def summary(self) -> str:
+        """Where the loop is stable, and how it loses stability, a line each."""
+        lo, hi = self.v_range
+        law = self.info.get("law", "")
+        loop = "sampled loop" if self.sampled else "continuous loop"
+        loop += " with a one-sample delay" if self.delay else ""
+        ref = self.reference_speed
+        lines = [
+            f"closed loop ({loop}{'; ' + law if law else ''}) over {lo:.5g} .. {hi:.5g} m/s: "
+            f"{'stable' if self.stable_at_reference else 'UNSTABLE'} at the reference speed "
+            f"{ref:.5g} m/s"
+        ]
+        f = self.flutter
+        if f is None:
+            lines.append(f"  no loss of stability above it up to {hi:.5g} m/s")
+        else:
+            lines.append(f"  closed-loop flutter: {loss_name(f['static'], f['frequency'])} at "
+                         f"{f['speed']:.6g} m/s")  # fmt: skip
+        if self.lower_speed is not None:
+            lines.append(f"  stable from {self.lower_speed:.6g} m/s ({self.lower_speed_kind})")
+        for u in self.unstable_intervals():
+            lines.append(f"  unstable {u['from']:.5g} .. {u['to']:.5g} m/s: {u['kind']}")
+        return "\n".join(lines)
+
+    def to_state(self) -> dict:
+        """Every field as plain data and arrays (for a file; :meth:`from_state`)."""
+        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+
+    @classmethod
+    def from_state(cls, state: dict) -> ClosedLoopBoundary:
+        """The boundary of :meth:`to_state`."""
+        return cls(**state)
+
+    def plot_boundary(
         self,
         ax=None,
         open_loop=None,

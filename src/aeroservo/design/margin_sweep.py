@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..result_shape import Result, shell
 from .closed_loop import plant_function
 from .margins import LoopMargins, MarginRequirement, loop_margins
 
@@ -27,8 +28,13 @@ QUANTITIES = (
 
 
 @dataclass
-class MarginSweep:
+class MarginSweep(Result):
     """Margins of a loop over a speed grid.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (one row per control and speed), :meth:`plot` (``"margin-sweep"``),
+    :meth:`to_json` and :meth:`save` (a ``.npz``); :meth:`table_for` gives one channel's
+    arrays.
 
     Attributes
     ----------
@@ -46,11 +52,53 @@ class MarginSweep:
     requirement: MarginRequirement
     reference_speed: float | None = None
 
+    FIGURES = {"margin-sweep": "plot_sweep"}
+
     @property
     def controls(self) -> tuple:
         return tuple(self.margins[0].channels) if self.margins else ()
 
-    def table(self, control: str | None = None) -> dict:
+    @property
+    def table(self):
+        """One row per control and speed (:func:`~.margin_tables.sweep_table`)."""
+        from .margin_tables import sweep_table
+
+        return sweep_table(self)
+
+    def summary(self) -> str:
+        """Per control, where the requirement holds and the least margins."""
+        from .margin_tables import sweep_summary
+
+        return sweep_summary(self)
+
+    def plot_sweep(self, control: str | None = None, title: str | None = None):
+        """Margins of one channel versus airspeed (:func:`aeroservo.plots.plot_margin_sweep`)."""
+        return shell("plot_margin_sweep")(self, control, title)
+
+    def to_state(self) -> dict:
+        """Every field as plain data and arrays (for a file; :meth:`from_state`)."""
+        from .margin_tables import requirement_state
+
+        return {
+            "speeds": self.speeds,
+            "margins": [m.to_state() for m in self.margins],
+            "requirement": requirement_state(self.requirement),
+            "reference_speed": self.reference_speed,
+        }
+
+    @classmethod
+    def from_state(cls, state: dict) -> MarginSweep:
+        """The sweep of :meth:`to_state`."""
+        from .margin_tables import requirement_from_state
+
+        return cls(
+            np.asarray(state["speeds"], dtype=float),
+            [LoopMargins.from_state(m) for m in state["margins"]],
+            requirement_from_state(state["requirement"]),
+            state["reference_speed"],
+        )
+
+    def table_for(self, control: str | None = None) -> dict:
         """``{quantity: ndarray over speed}`` for one channel (default the first); infinite
         margins stay inf, speeds where the loop is unstable are NaN; ``stable`` and ``meets``
         are boolean arrays."""
@@ -70,7 +118,7 @@ class MarginSweep:
     def meeting_range(self, control: str | None = None) -> tuple[float, float] | None:
         """Speeds [m/s] of the grid interval around the reference speed where the requirement
         holds (None if it fails there)."""
-        meets = self.table(control)["meets"]
+        meets = self.table_for(control)["meets"]
         ref = self.reference_speed if self.reference_speed is not None else self.speeds[0]
         i = int(np.argmin(np.abs(self.speeds - ref)))
         if not meets[i]:
@@ -91,7 +139,7 @@ class MarginSweep:
 
         per = {}
         for c in self.controls:
-            t = self.table(c)
+            t = self.table_for(c)
             per[c] = {q: clean(t[q]) for q in QUANTITIES}
             per[c]["stable"] = t["stable"].tolist()
             per[c]["meets"] = t["meets"].tolist()

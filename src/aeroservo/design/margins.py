@@ -30,6 +30,7 @@ import numpy as np
 import scipy.optimize as so
 
 from ..errors import InputError
+from ..result_shape import Result, shell
 from .interface import controller_at
 from .law import delayed
 from .margin_channel import (
@@ -38,6 +39,7 @@ from .margin_channel import (
     channel_margins,
     frequency_response,
 )
+from .margin_tables import margins_from_state, margins_state, margins_summary, margins_table
 from .plant import SampledPlant
 from .sampled_loop import LoopBlocks, linear_law, plant_states
 
@@ -56,8 +58,11 @@ BREAK_POINTS = {
 
 
 @dataclass
-class LoopMargins:
+class LoopMargins(Result):
     """Margins of a sampled loop at one speed (frequencies in Hz, gains in dB, phases in deg).
+
+    A result of the common shape (:mod:`aeroservo.result_shape`; one table row per break
+    point, figure ``"margins"``, saved as a ``.npz``).
 
     Attributes
     ----------
@@ -95,6 +100,27 @@ class LoopMargins:
     measured_input: bool = False
     law: str = ""
     multiloop_outputs: dict = field(default_factory=dict)
+
+    FIGURES = {"margins": "plot_margins"}
+
+    table = property(margins_table, doc="One row per break point (:func:`.margins_table`).")
+
+    def summary(self) -> str:
+        """The requirement met or missed and every break point's margins, a line each."""
+        return margins_summary(self)
+
+    def plot_margins(self, control: str | None = None, title: str | None = None):
+        """Nyquist, Bode, S and T of one channel (:func:`aeroservo.plots.plot_loop_margins`)."""
+        return shell("plot_loop_margins")(self, control, title)
+
+    def to_state(self) -> dict:
+        """Every field as plain data and arrays (for a file)."""
+        return margins_state(self)
+
+    @classmethod
+    def from_state(cls, state: dict) -> LoopMargins:
+        """The margins of :meth:`to_state`."""
+        return margins_from_state(cls, state)
 
     @property
     def break_point(self) -> str:

@@ -21,12 +21,13 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
+from ..result_shape import Result
 from ..stability.near_critical import NearCritical
 from ..stability.result import Crossing, FlutterResult
 from .summaries import json_text
 from .user_files import MAX_RESULT_BYTES, read_bytes
 
-__all__ = ["FORMAT", "SavedFlutter", "flutter_writer", "read_flutter"]
+__all__ = ["FORMAT", "SavedFlutter", "flutter_writer", "saved_writer", "read_flutter"]
 
 FORMAT = "aeroservo-flutter-1"
 UNITS = {
@@ -57,8 +58,13 @@ _SCALARS = (
 
 
 @dataclass
-class SavedFlutter:
+class SavedFlutter(Result):
     """A flutter result read back from a file.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary` and
+    :attr:`table` are the sweep's, :meth:`plot` draws ``"vg"``, ``"vf"``, ``"root-locus"``
+    and, with the mode shapes, ``"modes"`` and ``"flutter-mode"``; :meth:`save` writes the
+    same file again.
 
     Attributes
     ----------
@@ -86,6 +92,66 @@ class SavedFlutter:
     flutter_mode: dict | None = None
     surfaces: dict = field(default_factory=dict)
     meta: dict = field(default_factory=dict)
+
+    FIGURES = {
+        "vg": "plot_vg",
+        "vf": "plot_vf",
+        "root-locus": "plot_root_locus",
+        "modes": "plot_modes",
+        "flutter-mode": "plot_flutter_mode",
+    }
+
+    @property
+    def title(self) -> str | None:
+        """The title saved with the sweep (None: none)."""
+        return self.meta.get("title") or None
+
+    def summary(self, warnings: bool = True, units: str = "si") -> str:
+        """The sweep's summary (:meth:`FlutterResult.summary`)."""
+        return self.result.summary(warnings=warnings, units=units)
+
+    @property
+    def table(self):
+        """The sweep's branches (:attr:`FlutterResult.table`)."""
+        return self.result.table
+
+    def to_dict(self) -> dict:
+        """The sweep's record (:meth:`FlutterResult.to_dict`) with the p-k sweep's (``pk``)."""
+        return {**self.result.to_dict(), "pk": None if self.pk is None else self.pk.to_dict()}
+
+    @property
+    def figure_kinds(self) -> tuple[str, ...]:
+        """The sweep's figures, and the mode shapes' when the file has them."""
+        kinds = ["vg", "vf", "root-locus"] + (["modes"] if self.modes else [])
+        if self.modes and self.flutter_mode is not None and self.result.flutter is not None:
+            kinds.append("flutter-mode")
+        return tuple(kinds)
+
+    def plot_vg(self, **kw):
+        """V-f and V-g diagrams with the p-k sweep and the saved title
+        (:func:`aeroservo.plots.plot_vg`, its options)."""
+        return self.result.plot_vg(**{"title": self.title, "pk": self.pk, **kw})
+
+    def plot_vf(self, **kw):
+        """The V-f panel alone (the options of :meth:`plot_vg`)."""
+        return self.result.plot_vf(**{"title": self.title, "pk": self.pk, **kw})
+
+    def plot_root_locus(self, **kw):
+        """Root locus (:func:`aeroservo.plots.plot_root_locus`, its options)."""
+        return self.result.plot_root_locus(**{"title": self.title, **kw})
+
+    def plot_modes(self, fmax: float | None = None, modes=None, title: str | None = None):
+        """The natural mode shapes saved with the sweep (:func:`aeroservo.plots.plot_modes`);
+        ``fmax`` [Hz] and ``modes`` (numbers from 1) choose them as for :meth:`plot_vg`."""
+        from .flutter_figures import mode_shapes_figure
+
+        return mode_shapes_figure(self, fmax, modes, title or self.title)
+
+    def plot_flutter_mode(self, title: str | None = None):
+        """The flutter mode at the flutter speed (:func:`aeroservo.plots.plot_modes`)."""
+        from .flutter_figures import flutter_mode_figure
+
+        return flutter_mode_figure(self, title or self.title)
 
 
 def _sweep_arrays(prefix: str, r: FlutterResult) -> dict:
@@ -149,6 +215,38 @@ def flutter_writer(
     title : str
         A title for redrawn figures.
     """
+    modes, labels, surfaces, fmode = {}, [], {}, {}
+    if model is not None and hasattr(model, "natural_modes"):
+        nat = model.natural_modes(min(len(result.mode_labels), model.n_dofs))
+        modes = dict(model.mode_fields(nat.shapes))
+        modes["frequency"] = np.asarray(nat.frequencies, dtype=float)
+        labels = list(nat.labels)
+        surfaces = {cs.name: [float(cs.start), float(cs.end)] for cs in model.wing.control_surfaces}
+        q = _flutter_vector(model, result)
+        if q is not None:
+            fld = model.mode_fields(q[:, None])
+            fmode = {k: v if k == "x" else v[:, 0] for k, v in fld.items()}
+    return _writer(result, pk, wing_text, title, (modes, labels, surfaces, fmode))
+
+
+def saved_writer(saved: SavedFlutter):
+    """A writer of the ``.npz`` of a sweep read back (:class:`SavedFlutter`): the same file
+    again, with this aeroservo's version."""
+    modes = {k: v for k, v in saved.modes.items() if k != "label"}
+    labels = list(saved.modes.get("label", []))
+    return _writer(
+        saved.result,
+        saved.pk,
+        saved.wing_text,
+        str(saved.meta.get("title") or ""),
+        (modes, labels, dict(saved.surfaces), dict(saved.flutter_mode or {})),
+    )
+
+
+def _writer(result, pk, wing_text: str, title: str, shapes: tuple):
+    """The writer of the arrays and JSON header of a sweep; ``shapes``: the mode fields
+    (``x``, ..., ``frequency``), their labels, the surfaces and the flutter mode's fields."""
+    modes, labels, surfaces, fmode = shapes
     arrays = _sweep_arrays("", result)
     meta = {
         "format": FORMAT,
@@ -157,23 +255,13 @@ def flutter_writer(
         "units": UNITS,
         "sweep": _sweep_meta(result),
         "pk": None if pk is None else _sweep_meta(pk),
-        "surfaces": {},
-        "mode_labels": [],
+        "surfaces": surfaces if modes else {},
+        "mode_labels": labels if modes else [],
     }
     if pk is not None:
         arrays.update(_sweep_arrays("pk.", pk))
-    if model is not None and hasattr(model, "natural_modes"):
-        modes = model.natural_modes(min(len(result.mode_labels), model.n_dofs))
-        arrays.update({f"modes.{k}": v for k, v in model.mode_fields(modes.shapes).items()})
-        arrays["modes.frequency"] = np.asarray(modes.frequencies, dtype=float)
-        meta["mode_labels"] = list(modes.labels)
-        meta["surfaces"] = {
-            cs.name: [float(cs.start), float(cs.end)] for cs in model.wing.control_surfaces
-        }
-        q = _flutter_vector(model, result)
-        if q is not None:
-            fld = model.mode_fields(q[:, None])
-            arrays.update({f"flutter_mode.{k}": v if k == "x" else v[:, 0] for k, v in fld.items()})
+    arrays.update({f"modes.{k}": v for k, v in modes.items()})
+    arrays.update({f"flutter_mode.{k}": v for k, v in fmode.items()})
     arrays["wing_text"] = np.array(wing_text)
     arrays["meta"] = np.array(json_text(meta))
 

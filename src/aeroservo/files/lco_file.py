@@ -68,8 +68,8 @@ def _csv_text(header: list, rows: list) -> str:
 
 
 def table_csv(result: LCOResult) -> str:
-    """The CSV of :meth:`LCOResult.table` (one row per march; SI units, radians)."""
-    rows = [[r[k] for k in TABLE_COLUMNS] for r in result.table()]
+    """The CSV of :meth:`LCOResult.table_rows` (one row per march; SI units, radians)."""
+    rows = [[r[k] for k in TABLE_COLUMNS] for r in result.table_rows()]
     return _csv_text([_header(k) for k in TABLE_COLUMNS], rows)
 
 
@@ -102,7 +102,7 @@ def _doc(result: LCOResult, summary: dict, npz: Path | None) -> dict:
         "branches": None
         if b is None
         else {"gap": b.gap, "element": b.element, "names": list(b.names), "table": b.table()},
-        "summary_text": result.summary_text(),
+        "summary_text": result.summary(),
     }
 
 
@@ -141,7 +141,7 @@ def lco_items(result: LCOResult, json_path: str | Path, summary: dict) -> dict:
         items["histories"] = (npz, _npz_writer(arrays))
     items["summary_text"] = (
         stem.parent / f"{stem.name}_summary.txt",
-        _text(lambda: result.summary_text() + "\n"),
+        _text(lambda: result.summary() + "\n"),
     )
     return items
 

@@ -174,7 +174,7 @@ def plot_margin_sweep(
     """Gain (both ways), phase and disk margins of one channel versus airspeed, with the
     requirement; speeds where the loop is unstable are shaded."""
     control = control or sweep.controls[0]
-    t = sweep.table(control)
+    t = sweep.table_for(control)
     req = sweep.requirement
     v = sweep.speeds
     fig = new_figure(figsize=(7.5, 7.0))

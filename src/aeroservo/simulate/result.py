@@ -8,6 +8,7 @@ import numpy as np
 
 from ..design.plant import Limits
 from ..errors import InputError
+from ..result_shape import Result
 
 __all__ = ["SimulationResult", "WINDUP_RATIO", "windup_text", "LIMIT_SHOWN", "OPEN_LOOP_SCALE"]
 
@@ -20,6 +21,8 @@ with anti-windup; the issue-38 run lost at 8.6 x was not flagged at the former 1
 LIMIT_SHOWN = 3.0
 """A magnitude limit is drawn on the time-history figure when it is within this many times the
 signal's peak; otherwise it is named in the panel ("off scale")."""
+
+_GROUPS = ("outputs", "commands", "applied", "disturbance")
 
 OPEN_LOOP_SCALE = 2.0
 """An open-loop overlay is drawn up to where it leaves this many times the closed loop's peak."""
@@ -73,8 +76,12 @@ def windup_text(wound: dict) -> str:
 
 
 @dataclass
-class SimulationResult:
+class SimulationResult(Result):
     """Time histories of a closed-loop simulation (SI units).
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (one row per sample), :meth:`plot` (``"time"``), :meth:`to_json` and
+    :meth:`save` (the ``.npz`` of ``aeroservo simulate``).
 
     Attributes
     ----------
@@ -97,9 +104,9 @@ class SimulationResult:
     wall_time : float
         Wall time of the time marching and output evaluation [s] (the discretization of the
         plant before it is not included).
-    summary : dict
+    run_summary : dict
         Run summary of a result read back by :func:`aeroservo.files.results.load_result` (empty
-        otherwise).
+        otherwise; it was the attribute ``summary`` before ``summary()`` became the text).
     """
 
     t: np.ndarray
@@ -114,7 +121,9 @@ class SimulationResult:
     density: float = float("nan")
     states: np.ndarray | None = None
     wall_time: float = 0.0
-    summary: dict = field(default_factory=dict)
+    run_summary: dict = field(default_factory=dict)
+
+    FIGURES = {"time": "plot_time"}
 
     def signal(self, name: str) -> np.ndarray:
         """Any recorded signal by name."""
@@ -181,7 +190,7 @@ class SimulationResult:
         dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
         return {c: float(np.count_nonzero(m | r)) * dt for c, (m, r) in self.at_limits().items()}
 
-    def plot(
+    def plot_time(
         self,
         tip: str | None = None,
         control: str | None = None,
@@ -213,11 +222,12 @@ class SimulationResult:
             (n for n in ("tip_disp", *self.outputs) if n in self.outputs and n.startswith("tip")),
             next(iter(self.outputs)),
         )
-        control = control or next(iter(self.applied))
+        control = control or next(iter(self.applied), None)  # None: no control (open loop)
         deflection = deflection or next(
             (n for n in self.outputs if n.endswith("_deflection")), None
         )
-        panels = [g for g in self.disturbance if np.any(self.disturbance[g])] + [tip, control]
+        panels = [g for g in self.disturbance if np.any(self.disturbance[g])] + [tip]
+        panels += [control] if control else []
         panels += [deflection] if deflection else []
         fig = new_figure(figsize=(7.5, 2.1 * len(panels)))
         axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
@@ -247,7 +257,7 @@ class SimulationResult:
 
     def _control_panel(self, ax, name: str, k: float, unit: str) -> None:
         """Applied and commanded input, the axis scaled to the applied input; the limits drawn
-        when near it, else named (see :meth:`plot`)."""
+        when near it, else named (see :meth:`plot_time`)."""
         act = self.outputs.get(name + "_actuator")  # with an actuator: its output is applied
         applied = k * (self.applied[name] if act is None else act)
         command = k * self.commands[name]
@@ -278,3 +288,61 @@ class SimulationResult:
         for note in notes:  # legend lines: the legend keeps clear of the curves
             ax.plot([], [], " ", label=note)
         ax.legend(fontsize=7, loc="best")
+
+    @property
+    def table(self):
+        """The time histories, one row per sample (pandas DataFrame): ``t`` [s], then every
+        signal as ``<group>.<name>`` (``outputs``, ``commands``, ``applied``,
+        ``disturbance``: the names of the ``.npz`` file) in its unit (:attr:`units`); a signal
+        of several columns gives ``<group>.<name>[i]``."""
+        import pandas as pd
+
+        cols: dict = {"t": np.asarray(self.t)}
+        for group in _GROUPS:
+            for name, y in getattr(self, group).items():
+                y = np.asarray(y)
+                if y.ndim == 1:
+                    cols[f"{group}.{name}"] = y
+                else:
+                    for i, col in enumerate(y.reshape(y.shape[0], -1).T):
+                        cols[f"{group}.{name}[{i}]"] = col
+        return pd.DataFrame(cols)
+
+    def summary(self) -> str:
+        """The march, the peak of every signal and the time each control spent at its
+        limits, a line each."""
+        n = self.t.size
+        dt = float(self.t[1] - self.t[0]) if n > 1 else 0.0
+        off = not any(np.any(c) for c in self.commands.values())
+        lines = [
+            f"{'open loop (no command)' if off else 'closed loop'} at {self.speed:.6g} m/s TAS, "
+            f"density {self.density:.5g} kg/m^3: {n} samples of {dt:.4g} s, t = "
+            f"{float(self.t[0]) if n else 0.0:.4g} .. {float(self.t[-1]) if n else 0.0:.4g} s"
+        ]
+        for group, what in (("disturbance", "disturbance"), ("outputs", "output"),
+                            ("applied", "applied")):  # fmt: skip
+            for name, y in getattr(self, group).items():
+                y = np.asarray(y, dtype=float)
+                finite = np.isfinite(y).all()
+                peak = f"{np.max(np.abs(y), initial=0.0):.4g}" if finite else "non-finite"
+                lines.append(f"  {what} {name}: peak {peak} {self.units.get(name, '')}".rstrip())
+        at = self.time_at_limit() if n else {}
+        for c, s in at.items():
+            if s > 0:
+                lines.append(f"  {c} at its magnitude or rate limit for {s:.4g} s")
+        wound = self.windup()
+        if wound:
+            lines.append(f"  {windup_text(wound)}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The time histories and their settings (SI units; ``run_summary`` when read back)."""
+        return {
+            "speed": self.speed,
+            "density": self.density,
+            "units": dict(self.units),
+            "limits": {"magnitude": self.limits.magnitude, "rate": self.limits.rate},
+            "t": np.asarray(self.t),
+            **{g: dict(getattr(self, g)) for g in _GROUPS},
+            "run_summary": dict(self.run_summary),
+        }

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aero.atmosphere import KNOT, RHO0
+from ..result_shape import Result, shell
 
 __all__ = ["Crossing", "FlutterResult"]
 
@@ -40,8 +41,14 @@ class Crossing:
 
 
 @dataclass
-class FlutterResult:
+class FlutterResult(Result):
     """Stability of a model versus airspeed at one density.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table`, :meth:`plot` (``"vg"``, ``"vf"``, ``"root-locus"``), :meth:`to_json` and
+    ``save(path, model=..., pk=..., title=...)`` (a ``.npz`` that ``load_result`` reads back as
+    a :class:`~aeroservo.files.flutter_file.SavedFlutter`; the wing is needed: ``model`` or
+    ``wing_text``).
 
     Attributes
     ----------
@@ -109,9 +116,67 @@ class FlutterResult:
     damping: str = "none"
     near_critical: list = field(default_factory=list)
 
+    FIGURES = {"vg": "plot_vg", "vf": "plot_vf", "root-locus": "plot_root_locus"}
+
     def __post_init__(self) -> None:
         if self.searched_up_to is None:
             self.searched_up_to = self.v_max
+
+    def plot_vg(self, **kw):
+        """V-f and V-g diagrams (:func:`aeroservo.plots.plot_vg`, its options)."""
+        return shell("plot_vg")(self, **kw)
+
+    def plot_vf(self, **kw):
+        """The V-f panel of :meth:`plot_vg` alone (the same options)."""
+        fig = self.plot_vg(**kw)
+        ax_f, ax_g = fig.axes[:2]
+        fig.delaxes(ax_g)
+        ax_f.set_xlabel(ax_g.get_xlabel())
+        ax_f.tick_params(labelbottom=True)
+        return fig
+
+    def plot_root_locus(self, **kw):
+        """Root locus (:func:`aeroservo.plots.plot_root_locus`, its options)."""
+        return shell("plot_root_locus")(self, **kw)
+
+    @property
+    def table(self):
+        """The tracked branches, one row per branch and speed (pandas DataFrame), the columns
+        of the f06-like CSV (:mod:`aeroservo.files.flutter_table`) as numbers: ``mode``
+        (from 1), ``mode_label``, ``point`` (from 1), ``velocity_m_s``, ``eas_m_s``,
+        ``velocity_kt``, ``eas_kt``, ``mach`` (NaN without a speed of sound), ``damping_g``,
+        ``damping_zeta``, ``frequency_hz``, ``eigenvalue_real_1_s``, ``eigenvalue_imag_1_s``,
+        ``exact``; a p-k branch's speeds after it ended are left out."""
+        import pandas as pd
+
+        n_v, n_m = self.eigenvalues.shape
+        j, i = np.divmod(np.arange(n_v * n_m), n_v)  # mode-major, as the CSV
+        lam = self.eigenvalues[i, j]
+        keep = np.isfinite(lam)
+        j, i, lam = j[keep], i[keep], lam[keep]
+        v = np.asarray(self.speeds, dtype=float)[i]
+        eas = v * np.sqrt(self.density / RHO0)
+        exact = np.ones(lam.shape, bool) if self.exact is None else self.exact[i, j]
+        zeta = self.damping_ratio[i, j]
+        a = self.speed_of_sound
+        return pd.DataFrame(
+            {
+                "mode": j + 1,
+                "mode_label": [self.mode_labels[k] for k in j],
+                "point": i + 1,
+                "velocity_m_s": v,
+                "eas_m_s": eas,
+                "velocity_kt": v / KNOT,
+                "eas_kt": eas / KNOT,
+                "mach": v / a if a is not None else np.full(v.shape, np.nan),
+                "damping_g": -2.0 * zeta,
+                "damping_zeta": zeta,
+                "frequency_hz": self.frequencies[i, j],
+                "eigenvalue_real_1_s": lam.real,
+                "eigenvalue_imag_1_s": lam.imag,
+                "exact": exact,
+            }
+        )
 
     @property
     def complete(self) -> bool:

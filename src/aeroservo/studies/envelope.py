@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..aero.atmosphere import ALTITUDE_RANGE, KNOT, RHO0, isa
 from ..errors import InputError, check_number, check_quantity, parse_number
+from ..result_shape import Result
 from ..stability.matched import flutter_at
+from .envelope_point import EnvelopePoint, _checked_point, _optional_number
 
 __all__ = ["EnvelopePoint", "Envelope", "flutter_envelope", "MARGIN"]
 
@@ -29,66 +31,35 @@ MARGIN = 1.15
 """Required margin on the design envelope in EAS (CS 25.629, MIL-A-8870)."""
 
 
-@dataclass
-class EnvelopePoint:
-    """Flutter and divergence at one altitude (SI units; None: not found below the search).
+_COLUMNS = (
+    "altitude",
+    "density",
+    "speed_of_sound",
+    "flutter_speed",
+    "flutter_eas",
+    "flutter_mach",
+    "flutter_frequency",
+    "divergence_speed",
+    "divergence_eas",
+    "divergence_mach",
+    "searched_eas",
+)
+"""The columns of an envelope's table (with ``envelope_eas``, ``required_eas``, ``margin_ok``
+when it has a design envelope)."""
+_SPEEDS = ("flutter_speed", "flutter_eas", "divergence_speed", "divergence_eas", "searched_eas")
+_SPEEDS += ("envelope_eas", "required_eas")
+_KEYS = ("kind", "wing", "compressibility", "damping", "vd_eas", "md", "margin", "margin_ok")
+_KEYS += ("points", "units", "format")
 
-    ``searched_eas`` is the top of the search as an EAS [m/s]; ``envelope_eas`` and
-    ``required_eas`` the design envelope and ``margin`` x it [m/s EAS] (None without V_D/M_D).
+
+@dataclass
+class Envelope(Result):
+    """A flutter envelope: one :class:`EnvelopePoint` per altitude, increasing.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (one row per altitude), :meth:`plot` (``"envelope"``), :meth:`to_json` and
+    :meth:`save` (the JSON of ``aeroservo envelope --save``).
     """
-
-    altitude: float
-    density: float
-    speed_of_sound: float
-    flutter_speed: float | None
-    flutter_eas: float | None
-    flutter_mach: float | None
-    flutter_frequency: float | None
-    divergence_speed: float | None
-    divergence_eas: float | None
-    divergence_mach: float | None
-    searched_eas: float
-    envelope_eas: float | None = None
-    required_eas: float | None = None
-    margin_ok: bool | None = None
-    warnings: list = field(default_factory=list)
-
-    def to_dict(self) -> dict:
-        out = asdict(self)
-        if self.envelope_eas is None:
-            for k in ("envelope_eas", "required_eas", "margin_ok"):
-                out.pop(k)
-        return out
-
-
-def _optional_number(key: str, value: object) -> float | None:
-    return None if value is None else check_number(key, value)
-
-
-def _checked_point(i: int, p: object, names: set) -> dict:
-    """The fields of a saved envelope point, with their types checked."""
-    if not isinstance(p, dict):
-        raise InputError(f"points[{i}] = {p!r}: expected an object")
-    out = {k: v for k, v in p.items() if k in names}
-    for k, v in out.items():
-        if k == "warnings":
-            if not isinstance(v, list) or not all(isinstance(w, str) for w in v):
-                raise InputError(f"points[{i}].warnings = {v!r}: expected a list of strings")
-        elif k == "margin_ok":
-            if v is not None and not isinstance(v, bool):
-                raise InputError(f"points[{i}].margin_ok = {v!r}: expected true, false or null")
-        elif k == "altitude":
-            out[k] = check_number(f"points[{i}].altitude", v, unit="m", lo=-1000.0, hi=47000.0)
-        else:  # densities, speeds, Mach numbers, frequencies: positive where given
-            out[k] = _optional_number(f"points[{i}].{k}", v)
-            if out[k] is not None and out[k] < 0:
-                raise InputError(f"points[{i}].{k} = {out[k]:g}: must be >= 0")
-    return out
-
-
-@dataclass
-class Envelope:
-    """A flutter envelope: one :class:`EnvelopePoint` per altitude, increasing."""
 
     points: list
     vd: float | None = None
@@ -98,6 +69,8 @@ class Envelope:
     damping: str = "none"
     wing: str = ""
     info: dict = field(default_factory=dict)
+
+    FIGURES = {"envelope": "plot_envelope"}
 
     @property
     def altitudes(self) -> np.ndarray:
@@ -151,6 +124,7 @@ class Envelope:
                 compressibility=data.get("compressibility"),
                 damping=str(data.get("damping", "none")),
                 wing=str(data.get("wing", "")),
+                info={k: v for k, v in data.items() if k not in _KEYS},
             )
         except (KeyError, TypeError, AttributeError) as exc:
             raise InputError(f"not a valid flutter envelope ({exc})") from None
@@ -166,27 +140,14 @@ class Envelope:
         sig = np.array([math.sqrt(a.density / RHO0) for a in atms])
         return env, sig, np.array([a.speed_of_sound for a in atms])
 
+    def _columns(self) -> list[str]:
+        return list(_COLUMNS) + (["envelope_eas", "required_eas", "margin_ok"] * self.envelope)
+
     def csv_text(self, units: str = "si") -> str:
         """The table as CSV (one row per altitude; speeds in m/s, or knots)."""
-        speeds = ("flutter_speed", "flutter_eas", "divergence_speed", "divergence_eas")
-        speeds += ("searched_eas", "envelope_eas", "required_eas")
-        cols = [
-            "altitude",
-            "density",
-            "speed_of_sound",
-            "flutter_speed",
-            "flutter_eas",
-            "flutter_mach",
-            "flutter_frequency",
-            "divergence_speed",
-            "divergence_eas",
-            "divergence_mach",
-            "searched_eas",
-        ]
-        if self.envelope:
-            cols += ["envelope_eas", "required_eas", "margin_ok"]
+        cols = self._columns()
         kt = units == "knots"
-        head = [f"{c}_kt" if kt and c in speeds else c for c in cols]
+        head = [f"{c}_kt" if kt and c in _SPEEDS else c for c in cols]
         lines = [",".join(head)]
         for p in self.points:
             row = []
@@ -197,16 +158,53 @@ class Envelope:
                 elif isinstance(v, bool):
                     row.append("1" if v else "0")
                 else:
-                    row.append(f"{v / KNOT if kt and c in speeds else v:.10g}")
+                    row.append(f"{v / KNOT if kt and c in _SPEEDS else v:.10g}")
             lines.append(",".join(row))
         return "\n".join(lines) + "\n"
 
-    def plot(self, *, units: str = "si", x: str = "eas"):
+    @property
+    def table(self):
+        """One row per altitude, the columns of :meth:`csv_text` (pandas DataFrame; SI units:
+        m, kg/m^3, m/s, Hz; NaN where a speed was not found)."""
+        import pandas as pd
+
+        cols = self._columns()
+        out = pd.DataFrame({c: self.column(c) for c in cols if c != "margin_ok"}, columns=cols)
+        if self.envelope:
+            out["margin_ok"] = [bool(p.margin_ok) for p in self.points]
+        return out
+
+    def summary(self) -> str:
+        """The settings, then flutter and divergence at each altitude against the envelope."""
+        head = f"flutter envelope of {self.wing or 'the wing'}: damping {self.damping}, "
+        head += self.compressibility or "incompressible"
+        if self.envelope:
+            parts = [] if self.vd is None else [f"V_D {self.vd:.5g} m/s EAS"]
+            parts += [] if self.md is None else [f"M_D {self.md:.4g}"]
+            head += f"; {' and '.join(parts)} x {self.margin:g}: "
+            head += "every altitude passes" if self.margin_ok else "FAILS"
+        lines = [head]
+        for p in self.points:
+            text = f"  {p.altitude:8.6g} m: flutter {_at(p.flutter_eas, p.flutter_mach)}, "
+            text += f"divergence {_at(p.divergence_eas, p.divergence_mach)}; searched to "
+            text += f"{p.searched_eas:.5g} m/s EAS"
+            if p.required_eas is not None:
+                text += f"; required {p.required_eas:.5g}: {'ok' if p.margin_ok else 'FAILS'}"
+            lines.append(text)
+        return "\n".join(lines)
+
+    def plot_envelope(self, *, units: str = "si", x: str = "eas"):
         """Altitude against EAS (or Mach, ``x="mach"``): flutter and divergence boundaries,
         the design envelope and the margin line, failing points marked (matplotlib Figure)."""
         from ..plots import plot_envelope
 
         return plot_envelope(self, units=units, x=x)
+
+
+def _at(eas: float | None, mach: float | None) -> str:
+    if eas is None:
+        return "none"
+    return f"{eas:.5g} m/s EAS" + ("" if mach is None else f" (Mach {mach:.3f})")
 
 
 def _envelope_eas(alt, vd: float | None, md: float | None) -> float | None:

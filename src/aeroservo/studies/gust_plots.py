@@ -7,7 +7,8 @@
   discrete-gust points and the turbulence design ellipse (:func:`design_ellipse`);
 * :func:`plot_gust_history`, :func:`plot_critical_gusts`, :func:`plot_tuning`
   (:mod:`aeroservo.studies.gust_history_plots`): the critical gust of one load at one flight
-  point, that of every load at its worst point, and the tuning search over the gust gradient.
+  point, that of every load at its worst point, and the tuning search over the gust gradient;
+* :func:`gust_figures`: the figures a run writes (and ``GustLoadsResult.plot`` draws).
 
 Loads are increments of the wing clamped at its root (no rigid-body modes, no 1 g load). Data
 are SI; the figures show kN, kN m and degrees (:data:`~aeroservo.studies.gust_plot_parts.
@@ -54,6 +55,10 @@ __all__ = [
     "plot_tuning",
     "design_ellipse",
     "discrete_points",
+    "gust_figures",
+    "drawable",
+    "FIGURES",
+    "CORRELATED",
 ]
 
 SIDE_MARKERS = {("x", "max"): ">", ("x", "min"): "<", ("y", "max"): "^", ("y", "min"): "v"}
@@ -314,3 +319,45 @@ def plot_correlated(
     footer(fig, notes)
     fig.suptitle(f"{result.name}: correlated loads\n{INCREMENTAL}", fontsize=10)
     return fig
+
+
+CORRELATED = ("root_bending_moment", "root_torque")
+"""The pair of loads of the correlated-load figure (x, y), drawn when both are loads."""
+
+FIGURES = ("envelope", "correlated", "critical_gusts", "spanwise")
+"""The figures of a gust-loads run, by file suffix (:func:`gust_figures`)."""
+
+
+def gust_figures(result, which=FIGURES) -> dict:
+    """The figures a gust-loads run writes, by file suffix: ``envelope`` (limit loads per flight
+    point), ``correlated`` (root bending moment against root torque, only when both are loads)
+    ``critical_gusts`` (time histories of the critical gusts) and ``spanwise`` (limit loads along
+    the span, only with loads at two or more stations, whose loads the envelope and the critical
+    gusts then leave to it); ``which``: those to draw. See :mod:`aeroservo.studies.gust_span_plots`
+    for the spanwise figure."""
+    from . import gust_span_plots
+
+    span = gust_span_plots.span_loads(result)
+    # the station loads are the spanwise figure's; the per-load figures keep the others
+    stations = {n for items in span.values() for _x, n in items if not n.startswith("root_")}
+    loads = [n for n in result.loads if n not in stations]
+    draw = {
+        "envelope": lambda r: plot_envelope(r, loads),
+        "correlated": lambda r: plot_correlated(r, *CORRELATED),
+        "critical_gusts": lambda r: plot_critical_gusts(r, loads),
+        "spanwise": gust_span_plots.plot_spanwise,
+    }
+    can = drawable(result, span)
+    return {name: draw[name](result) for name in FIGURES if name in which and can.get(name, True)}
+
+
+def drawable(result, span: dict | None = None) -> dict:
+    """Whether the optional figures of a run can be drawn, by file suffix: ``correlated``
+    (both loads of :data:`CORRELATED`) and ``spanwise`` (loads at two or more stations;
+    ``span``: :func:`~aeroservo.studies.gust_span_plots.span_loads` when known)."""
+    from .gust_span_plots import span_loads
+
+    return {
+        "correlated": all(n in result.loads for n in CORRELATED),
+        "spanwise": bool(span_loads(result) if span is None else span),
+    }

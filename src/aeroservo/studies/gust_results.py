@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..result_shape import Result
 from .gust_records import totals
 
 __all__ = ["GustLoadsResult", "RAISE_TOLERANCE"]
@@ -40,8 +41,13 @@ times the accuracy of the sampled march against the exact one, ``docs/gust-loads
 
 
 @dataclass
-class GustLoadsResult:
+class GustLoadsResult(Result):
     """Records of a gust-loads study (see the module docstring).
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (limit loads), :meth:`plot` (``"envelope"``, ``"correlated"``,
+    ``"critical-gusts"``, ``"spanwise"``: the figures ``aeroservo loads`` writes),
+    :meth:`to_json` and :meth:`save` (its ``.json`` with the ``.npz``, ``.csv`` next to it).
 
     Attributes
     ----------
@@ -61,6 +67,13 @@ class GustLoadsResult:
     arrays: dict = field(default_factory=dict)
     units: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
+
+    FIGURES = {
+        "envelope": "plot_envelope",
+        "correlated": "plot_correlated",
+        "critical-gusts": "plot_critical_gusts",
+        "spanwise": "plot_spanwise",
+    }
 
     @property
     def loads(self) -> list[str]:
@@ -210,6 +223,58 @@ class GustLoadsResult:
         )
 
     def summary_text(self) -> str:
+        """Deprecated: :meth:`summary`."""
+        import warnings
+
+        warnings.warn("summary_text() is summary()", DeprecationWarning, stacklevel=2)
+        return self.summary()
+
+    def to_dict(self) -> dict:
+        """The study's name, load units, settings and every record (JSON values; the time
+        histories are in :attr:`arrays`)."""
+        return {
+            "name": self.name,
+            "units": dict(self.units),
+            "settings": dict(self.settings),
+            "records": self.records,
+        }
+
+    @property
+    def figure_kinds(self) -> tuple[str, ...]:
+        """The figures of :attr:`FIGURES` a run writes for this result (``correlated`` with
+        both root bending moment and root torque, ``spanwise`` with station loads)."""
+        from .gust_plots import drawable
+
+        can = drawable(self)
+        return tuple(k for k in self.FIGURES if can.get(k.replace("-", "_"), True))
+
+    def plot(self, kind: str | None = None, **kw):
+        """A figure: without options, the one ``aeroservo loads`` writes for ``kind``
+        (:func:`~aeroservo.studies.gust_plots.gust_figures`: with station loads the envelope
+        and the critical gusts leave those to the spanwise figure); with options, the method
+        :attr:`FIGURES` names (e.g. ``plot("correlated", x=..., y=...)``).
+
+        Parameters
+        ----------
+        kind : {"envelope", "correlated", "critical-gusts", "spanwise"}, optional
+            Default ``"envelope"``.
+        """
+        from .gust_plots import gust_figures
+
+        if kw or kind not in (None, *self.FIGURES):
+            return super().plot(kind, **kw)
+        kind = kind or "envelope"
+        figs = gust_figures(self, (kind.replace("-", "_"),))
+        if not figs:
+            need = (
+                "loads at two or more stations (root loads, load_stations)"
+                if kind == "spanwise"
+                else "both root_bending_moment and root_torque as loads"
+            )
+            raise InputError(f"kind = {kind!r}: the result has not {need}")
+        return next(iter(figs.values()))
+
+    def summary(self) -> str:
         """A loads engineer's summary: worst limit load per load and loop, GLA, flags."""
         lines = [f"gust loads {self.name}: {len({r['point'] for r in self.records})} points"]
         if self.settings.get("loop_measures"):

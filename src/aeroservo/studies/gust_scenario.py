@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from ..errors import InputError
+from .gust_plots import CORRELATED, FIGURES, gust_figures
 from .gust_results import _point_label as _label
 from .kinds import Run, check_kind
 from .scenario import Scenario
@@ -23,10 +24,8 @@ __all__ = [
     "gust_summary",
     "gust_figures",
     "FIGURES",
+    "CORRELATED",
 ]
-
-CORRELATED = ("root_bending_moment", "root_torque")
-"""The pair of loads of the correlated-load figure (x, y), drawn when both are loads."""
 
 
 def gust_study(scenario: Scenario):
@@ -185,33 +184,3 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
             {k: _plain(v) for k, v in row.items()} for row in a.to_dict(orient="records")
         ]
     return summary
-
-
-FIGURES = ("envelope", "correlated", "critical_gusts", "spanwise")
-"""The figures of a gust-loads run, by file suffix (:func:`gust_figures`)."""
-
-
-def gust_figures(result, which=FIGURES) -> dict:
-    """The figures a gust-loads run writes, by file suffix: ``envelope`` (limit loads per flight
-    point), ``correlated`` (root bending moment against root torque, only when both are loads)
-    ``critical_gusts`` (time histories of the critical gusts) and ``spanwise`` (limit loads along
-    the span, only with loads at two or more stations, whose loads the envelope and the critical
-    gusts then leave to it); ``which``: those to draw. See
-    :mod:`aeroservo.studies.gust_plots` and :mod:`aeroservo.studies.gust_span_plots`."""
-    from . import gust_plots, gust_span_plots
-
-    span = gust_span_plots.span_loads(result)
-    # the station loads are the spanwise figure's; the per-load figures keep the others
-    stations = {n for items in span.values() for _x, n in items if not n.startswith("root_")}
-    loads = [n for n in result.loads if n not in stations]
-    draw = {
-        "envelope": lambda r: gust_plots.plot_envelope(r, loads),
-        "correlated": lambda r: gust_plots.plot_correlated(r, *CORRELATED),
-        "critical_gusts": lambda r: gust_plots.plot_critical_gusts(r, loads),
-        "spanwise": gust_span_plots.plot_spanwise,
-    }
-    can = {
-        "correlated": all(n in result.loads for n in CORRELATED),
-        "spanwise": bool(span),
-    }
-    return {name: draw[name](result) for name in FIGURES if name in which and can.get(name, True)}

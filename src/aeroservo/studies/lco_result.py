@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..result_shape import Result
+
 __all__ = ["LCOResult", "TABLE_COLUMNS", "describing_lines"]
 
 TABLE_COLUMNS = (
@@ -27,11 +29,15 @@ TABLE_COLUMNS = (
     "switches_per_second",
     "reason",
 )
-"""Columns of :meth:`LCOResult.table` (SI: m/s, rad, Hz, 1/s)."""
+"""Columns of :attr:`LCOResult.table` (SI: m/s, rad, Hz, 1/s)."""
 
 
-class LCOResult:
+class LCOResult(Result):
     """Verdicts of the marches of a study and the describing-function branches.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (one row per march), :meth:`plot` (``"bifurcation"``, ``"histories"``),
+    :meth:`to_json` and :meth:`save` (the ``.json`` of ``aeroservo lco`` with its files).
 
     Attributes
     ----------
@@ -46,6 +52,8 @@ class LCOResult:
         What was run (elements, laws, speeds, amplitudes, duration, controller, timing, notes).
     branches : DescribingBranches or None
     """
+
+    FIGURES = {"bifurcation": "_bifurcation_figure", "histories": "plot_histories"}
 
     def __init__(self, rows: list, settings: dict, branches=None):
         self.rows = list(rows)
@@ -62,13 +70,41 @@ class LCOResult:
     def gap(self) -> float | None:
         return self.settings.get("gap")
 
-    def table(self, start: str | None = None) -> list[dict]:
-        """Rows without histories (of one ``start`` kind if given)."""
+    def table_rows(self, start: str | None = None) -> list[dict]:
+        """Rows without histories, the columns :data:`TABLE_COLUMNS` (of one ``start`` kind,
+        ``"point"``, ``"up"`` or ``"down"``, if given)."""
         return [
             {k: r[k] for k in TABLE_COLUMNS}
             for r in self.rows
             if start is None or r["start"] == start
         ]
+
+    @property
+    def table(self):
+        """One row per march, the columns :data:`TABLE_COLUMNS` (pandas DataFrame; SI: m/s,
+        rad, Hz, 1/s; NaN where a number is undefined)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.table_rows(), columns=list(TABLE_COLUMNS))
+
+    def to_dict(self) -> dict:
+        """The settings, every march's row without its history and the describing-function
+        branches (JSON values, SI units)."""
+        b = self.branches
+        return {
+            "name": self.settings.get("name", ""),
+            "settings": dict(self.settings),
+            "rows": [{k: v for k, v in r.items() if k != "history"} for r in self.rows],
+            "branches": None
+            if b is None
+            else {"gap": b.gap, "element": b.element, "names": list(b.names), "table": b.table()},
+        }
+
+    @property
+    def figure_kinds(self) -> tuple[str, ...]:
+        """``bifurcation``, and ``histories`` when the marches kept time histories."""
+        has = any(r.get("history") for r in self.rows)
+        return ("bifurcation", "histories") if has else ("bifurcation",)
 
     def lco_rows(self) -> list[dict]:
         """The marches that settled in a limit cycle."""
@@ -101,6 +137,13 @@ class LCOResult:
         return out
 
     def summary_text(self) -> str:
+        """Deprecated: :meth:`summary`."""
+        import warnings
+
+        warnings.warn("summary_text() is summary()", DeprecationWarning, stacklevel=2)
+        return self.summary()
+
+    def summary(self) -> str:
         """A few lines a flutter engineer reads first."""
         s = self.settings
         gap = self.gap
@@ -149,11 +192,14 @@ class LCOResult:
         lines += list(s.get("notes", []))
         return "\n".join(lines)
 
-    def plot(self, ax=None, **kw):
-        """The bifurcation diagram (:func:`.lco_plots.plot_bifurcation`)."""
+    def plot_bifurcation(self, ax=None, **kw):
+        """The bifurcation diagram (:func:`.lco_plots.plot_bifurcation`): its Axes."""
         from .lco_plots import plot_bifurcation
 
         return plot_bifurcation(self, ax=ax, **kw)
+
+    def _bifurcation_figure(self, **kw):
+        return self.plot_bifurcation(**kw).figure
 
     def plot_histories(self, speeds=None, **kw):
         """Example time histories (:func:`.lco_plots.plot_histories`)."""

@@ -246,7 +246,7 @@ def lco_figures(result, which=FIGURES) -> dict:
     See :mod:`aeroservo.studies.lco_plots`."""
     out = {}
     if "bifurcation" in which:
-        out["bifurcation"] = result.plot().figure
+        out["bifurcation"] = result.plot_bifurcation().figure
     if "histories" in which and any(r.get("history") for r in result.rows):
         out["histories"] = result.plot_histories()
     return out

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, check_number
+from ..result_shape import Result
 
 __all__ = ["RecoverableSet", "recoverable_set", "SETTLE", "THRESHOLD"]
 
@@ -32,8 +33,12 @@ THRESHOLD = 0.05
 
 
 @dataclass
-class RecoverableSet:
+class RecoverableSet(Result):
     """Which initial deflections and limits a loop recovers from (SI units).
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table` (one row per cell), :meth:`plot` (``"recovery"``), :meth:`to_json` and
+    :meth:`save` (a ``.npz``).
 
     Attributes
     ----------
@@ -59,6 +64,8 @@ class RecoverableSet:
     controller: str
     recovered: dict = field(default_factory=dict)
     final: dict = field(default_factory=dict)
+
+    FIGURES = {"recovery": "plot_recovery"}
 
     def count(self, anti_windup: bool) -> int:
         """Cells recovered with anti-windup on (True) or off (False)."""
@@ -89,7 +96,48 @@ class RecoverableSet:
             )
         return "\n".join(lines)
 
-    def plot(self):
+    @property
+    def table(self):
+        """One row per initial deflection and limit (pandas DataFrame): ``deflection_m``,
+        ``magnitude`` (the limit, in the control's unit), ``recovered_anti_windup``,
+        ``recovered_plain`` and the final state sizes ``final_anti_windup``,
+        ``final_plain`` (relative to the initial one; inf: a signal not finite)."""
+        import pandas as pd
+
+        i, j = np.divmod(np.arange(self.deflections.size * self.magnitudes.size),
+                         self.magnitudes.size)  # fmt: skip
+        out = {"deflection_m": self.deflections[i], "magnitude": self.magnitudes[j]}
+        for on, name in ((True, "anti_windup"), (False, "plain")):
+            if on in self.recovered:
+                out[f"recovered_{name}"] = self.recovered[on][i, j]
+                out[f"final_{name}"] = self.final[on][i, j]
+        return pd.DataFrame(out)
+
+    def to_dict(self) -> dict:
+        """The grid and, anti-windup on and off, the recovered cells and final sizes."""
+        out = {k: getattr(self, k) for k in ("control", "speed", "controller")}
+        out |= {"deflections": self.deflections, "magnitudes": self.magnitudes}
+        for on, name in ((True, "anti_windup"), (False, "plain")):
+            if on in self.recovered:
+                out[f"recovered_{name}"], out[f"final_{name}"] = self.recovered[on], self.final[on]
+        return out
+
+    def to_state(self) -> dict:
+        """Every field as plain data and arrays (for a file; :meth:`from_state`)."""
+        return self.to_dict()
+
+    @classmethod
+    def from_state(cls, state: dict) -> RecoverableSet:
+        """The set of :meth:`to_state`."""
+        out = cls(*(state[k] for k in ("deflections", "magnitudes", "control", "speed")),
+                  state["controller"])  # fmt: skip
+        for on, name in ((True, "anti_windup"), (False, "plain")):
+            if f"recovered_{name}" in state:
+                out.recovered[on] = np.asarray(state[f"recovered_{name}"], dtype=bool)
+                out.final[on] = np.asarray(state[f"final_{name}"], dtype=float)
+        return out
+
+    def plot_recovery(self):
         """The two grids side by side (recovered cells filled)."""
         from .._figures import new_figure
 

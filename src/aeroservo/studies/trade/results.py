@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
+from ...result_shape import Result
 from .plots import HEATMAP_METRICS, _heatmap, _pareto
 from .ranking import BEST_CRITERION, best_index, is_closed_loop
 from .study import FORMAT, METRICS, PARAMETERS
@@ -19,8 +20,13 @@ _TEXT = ("status", "failed_stage", "error")
 
 
 @dataclass
-class TradeResult:
+class TradeResult(Result):
     """Results of a trade study.
+
+    A result of the common shape (:mod:`aeroservo.result_shape`): :meth:`summary`,
+    :attr:`table`, :meth:`plot` (``"pareto"``: :meth:`pareto`, ``"heatmap"``:
+    :meth:`heatmap`), :meth:`to_json` and :meth:`save` (a folder as a run writes it:
+    ``study.json``, the CSV and the NetCDF file).
 
     Attributes
     ----------
@@ -53,6 +59,8 @@ class TradeResult:
     netcdf_path: Path | None = None
     n_skipped: int = 0
     elapsed: float = 0.0
+
+    FIGURES = {"pareto": "pareto", "heatmap": "heatmap"}
 
     @property
     def n_cases(self) -> int:
@@ -143,6 +151,37 @@ class TradeResult:
         """
         best = best_index(self.table, self.closed_loop)
         return _pareto(self.table, self.name, list(self.parameters), best)
+
+    def summary(self) -> str:
+        """The grid, the cases that failed and the best case, a line each."""
+        dims = " x ".join(f"{k} [{len(v)}]" for k, v in self.parameters.items())
+        lines = [
+            f"trade study {self.name}: {dims} = {self.n_cases} cases, {self.n_failed} failed "
+            f"({'closed loop' if self.closed_loop else 'open loop'})"
+        ]
+        failed = self.table[self.table["status"] != "ok"]
+        for stage, n in failed["failed_stage"].value_counts(sort=False).items():
+            lines.append(f"  {n} failed in {stage or 'an unknown stage'}")
+        best = self.best_case()
+        if best is None:
+            lines.append("  no best case (no case succeeded)")
+        else:
+            at = ", ".join(f"{k} = {best[k]:g}" for k in self.parameters)
+            lines.append(f"  best case {best['case_id']} ({self.best_criterion}): {at}")
+            for m in ("open_loop_flutter_speed", "closed_loop_flutter_speed",
+                      "suppression_margin", "hinge_moment_peak"):  # fmt: skip
+                if m in best and np.isfinite(best[m]):
+                    lines.append(f"    {m} = {best[m]:.6g} {METRICS[m][0]}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The study's name, parameters, settings and every case (a row of :attr:`table`)."""
+        return {
+            "name": self.name,
+            "parameters": {k: list(v) for k, v in self.parameters.items()},
+            "settings": dict(self.settings),
+            "cases": self.table.to_dict(orient="records"),
+        }
 
     def figures(self) -> dict:
         """The figures a run writes: ``{file name: figure}``.

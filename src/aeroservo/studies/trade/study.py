@@ -29,7 +29,7 @@ compiled NetCDF/HDF5 library, only SciPy, already a dependency. The same cases a
 written as a flat CSV table (one row per case) for spreadsheets. ``out_dir/study.json``
 describes the study so that :func:`load_trade` can re-read it for re-plotting.
 
-Dask, xarray and pandas are imported only when needed; they come with the ``trade`` extra.
+Dask, xarray and pandas are imported only when needed; Dask and xarray: the ``trade`` extra.
 """
 
 from __future__ import annotations
