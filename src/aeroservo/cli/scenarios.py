@@ -153,7 +153,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _study_report(run, files: dict) -> str:
     """A study's report: its name and kind, its result's summary and the files written."""
-    lines = [f"{run.scenario.name} [{run.scenario.kind}]", run.result.summary_text()]
+    lines = [f"{run.scenario.name} [{run.scenario.kind}]", run.result.summary()]
     lines += [f"  wrote {kind}: {path}" for kind, path in files.items()]
     return "\n".join(lines)
 
