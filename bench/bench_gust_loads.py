@@ -23,8 +23,8 @@ from _timing import median
 
 from aeroservo.files.scenario_file import load_scenario
 from aeroservo.stability.boundary import flutter_boundary
-from aeroservo.studies.tuned_gusts import tuned_gust_loads
-from aeroservo.studies.turbulence import turbulence_response
+from aeroservo.studies.gust.tuned import tuned_gust_loads
+from aeroservo.studies.gust.turbulence import turbulence_response
 
 LOADS = [
     "root_shear",
@@ -91,8 +91,8 @@ def main() -> None:
 
 def _stations(sc, quick: bool) -> tuple[float, float]:
     """Wall time of one flight point of a study with the root loads, then with 5 stations."""
-    from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
-    from aeroservo.studies.gust_point import evaluate_point
+    from aeroservo.studies.gust.point import evaluate_point
+    from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
 
     def study(stations):
         return GustLoadsStudy(

@@ -28,11 +28,11 @@ from _timing import median
 from aeroservo.design.hinge_loop import loop_hinge_plant
 from aeroservo.files.scenario_file import load_scenario
 from aeroservo.linear.hinge_plant import nonlinear_plant
-from aeroservo.simulate.hinge_march import march_hinges
+from aeroservo.simulate.hinges.march import march_hinges
 from aeroservo.simulate.march import simulate
 from aeroservo.structure.hinge_laws import Freeplay
-from aeroservo.studies.lco import LCOSetup, LCOSweep
-from aeroservo.studies.lco_run import run_lco
+from aeroservo.studies.lco.run import run_lco
+from aeroservo.studies.lco.study import LCOSetup, LCOSweep
 from aeroservo.system.hinge_elements import NonlinearHinge
 
 GAP = float(np.radians(1.0))

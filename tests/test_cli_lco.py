@@ -24,8 +24,8 @@ from aeroservo.files.wing_file import load_hinges, load_wing, wing_from_dict, wi
 from aeroservo.stability.describing_function import DescribingBranches
 from aeroservo.structure.examples import goland_aileron
 from aeroservo.structure.hinge_laws import Cubic, Freeplay
-from aeroservo.studies.lco_result import TABLE_COLUMNS
-from aeroservo.studies.lco_scenario import lco_setup
+from aeroservo.studies.lco.result import TABLE_COLUMNS
+from aeroservo.studies.lco.scenario import lco_setup
 from aeroservo.studies.runs import run_scenario
 from aeroservo.studies.scenario import quick
 from aeroservo.system.hinge_elements import NonlinearHinge

@@ -23,7 +23,7 @@ from aeroservo.files.hinge_tables import _KEYS
 from aeroservo.files.lco_file import TABLE_UNITS, load_lco, write_lco
 from aeroservo.files.lco_tables import SECTION_KEYS
 from aeroservo.files.scenario_file import load_scenario
-from aeroservo.studies.lco_result import TABLE_COLUMNS
+from aeroservo.studies.lco.result import TABLE_COLUMNS
 
 SCENARIOS = ROOT / "scenarios"
 CONTROLLERS = ROOT / "controllers"
@@ -327,7 +327,7 @@ def test_command_line_errors_one_line(case, scenario_file, tmp_path, monkeypatch
 
 def test_interrupted_run_leaves_nothing(scenario_file, tmp_path, monkeypatch):
     """Ctrl-C during the marches: exit 130, one line, no output folder."""
-    import aeroservo.studies.lco_run as lco_run
+    import aeroservo.studies.lco.run as lco_run
 
     def interrupted(shared, task):
         raise KeyboardInterrupt

@@ -15,7 +15,7 @@ from aeroservo.cli import main
 from aeroservo.errors import InputError
 from aeroservo.files.gust_loads_file import load_gust_loads, write_gust_loads
 from aeroservo.files.scenario_file import load_scenario
-from aeroservo.studies.gust_scenario import gust_study
+from aeroservo.studies.gust.scenario import gust_study
 from aeroservo.studies.runs import run_scenario
 from aeroservo.studies.scenario import quick
 

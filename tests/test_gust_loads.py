@@ -26,11 +26,11 @@ from aeroservo.design.interface import static_gain
 from aeroservo.design.law import pad_state_map
 from aeroservo.errors import InputError
 from aeroservo.files.scenario_file import load_scenario
-from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
-from aeroservo.studies.gust_point import design_point, evaluate_point, in_state_basis
-from aeroservo.studies.gust_results import RAISE_TOLERANCE
-from aeroservo.studies.gust_run import run_gust_loads
-from aeroservo.studies.tuned_gusts import tuned_gust_loads
+from aeroservo.studies.gust.point import design_point, evaluate_point, in_state_basis
+from aeroservo.studies.gust.results import RAISE_TOLERANCE
+from aeroservo.studies.gust.run import run_gust_loads
+from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
+from aeroservo.studies.gust.tuned import tuned_gust_loads
 
 LOADS = ("root_shear", "root_bending_moment", "root_torque", "tip_twist")
 CONTROL = "aileron_hinge_moment"

@@ -25,8 +25,8 @@ from aeroservo.design.interface import static_gain
 from aeroservo.design.loop import ControlLoop
 from aeroservo.design.plant import Limits, OpenLoop
 from aeroservo.errors import InputError
-from aeroservo.studies.gust_march import LoopGustMarch, profile
-from aeroservo.studies.tuned_gusts import tuned_gust_loads
+from aeroservo.studies.gust.march import LoopGustMarch, profile
+from aeroservo.studies.gust.tuned import tuned_gust_loads
 from aeroservo.system.aeroelastic import AeroelasticModel
 
 LOADS = ["root_shear", "root_bending_moment", "root_torque", "tip_twist", "aileron_deflection"]

@@ -1,4 +1,4 @@
-"""Figures of a gust-loads study (``aeroservo.studies.gust_plots``), drawn from a
+"""Figures of a gust-loads study (``aeroservo.studies.gust.plots``), drawn from a
 ``GustLoadsResult`` alone.
 
 Independent checks, in this file:
@@ -26,10 +26,10 @@ from matplotlib.figure import Figure
 
 from aeroservo.errors import InputError
 from aeroservo.files.scenario_file import load_scenario
-from aeroservo.studies import gust_plots as gp
-from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
-from aeroservo.studies.gust_run import run_gust_loads
-from aeroservo.studies.turbulence import turbulence_response
+from aeroservo.studies.gust import plots as gp
+from aeroservo.studies.gust.run import run_gust_loads
+from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
+from aeroservo.studies.gust.turbulence import turbulence_response
 
 matplotlib.use("Agg")
 

@@ -30,7 +30,7 @@ from aeroservo.errors import InputError
 from aeroservo.files import load_controller
 from aeroservo.linear.hinge_plant import nonlinear_plant, section_plant
 from aeroservo.simulate import simulate
-from aeroservo.simulate.hinge_march import march_hinges
+from aeroservo.simulate.hinges.march import march_hinges
 from aeroservo.structure.hinge_laws import Bilinear, Cubic, Freeplay
 from aeroservo.system import TypicalSection
 from aeroservo.system.hinge_elements import NonlinearHinge

@@ -40,11 +40,11 @@ from aeroservo.design.sampled_loop import linear_law, plant_states
 from aeroservo.errors import InputError
 from aeroservo.files import load_controller
 from aeroservo.linear.hinge_plant import nonlinear_plant, section_plant
-from aeroservo.simulate.hinge_march import march_hinges
+from aeroservo.simulate.hinges.march import march_hinges
 from aeroservo.structure.hinge_laws import Bilinear, Cubic, Freeplay
-from aeroservo.studies.lco import DIVERGED, LCOSetup, LCOSweep
-from aeroservo.studies.lco_result import _branch_at
-from aeroservo.studies.lco_run import run_lco
+from aeroservo.studies.lco.result import _branch_at
+from aeroservo.studies.lco.run import run_lco
+from aeroservo.studies.lco.study import DIVERGED, LCOSetup, LCOSweep
 from aeroservo.system.hinge_elements import NonlinearHinge
 from aeroservo.system.section import CONNER, conner_section
 

@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 
 from aeroservo.structure.hinge_laws import Freeplay
-from aeroservo.studies.lco import LCOSetup, LCOSweep
-from aeroservo.studies.lco_result import _branch_at
-from aeroservo.studies.lco_run import run_lco
+from aeroservo.studies.lco.result import _branch_at
+from aeroservo.studies.lco.run import run_lco
+from aeroservo.studies.lco.study import LCOSetup, LCOSweep
 from aeroservo.system.hinge_elements import NonlinearHinge
 from aeroservo.system.section import CONNER, conner_section
 

@@ -30,12 +30,12 @@ from aeroservo.design.interface import python_law, static_gain
 from aeroservo.design.plant import OpenLoop
 from aeroservo.errors import InputError
 from aeroservo.files import load_controller
-from aeroservo.simulate.hinge_march import march_hinges
+from aeroservo.simulate.hinges.march import march_hinges
 from aeroservo.simulate.lco_detect import classify
 from aeroservo.stability.describing_function import describing_branches
 from aeroservo.structure.hinge_laws import Freeplay
-from aeroservo.studies.lco import LCOSetup, LCOSweep
-from aeroservo.studies.lco_run import _describing
+from aeroservo.studies.lco.run import _describing
+from aeroservo.studies.lco.study import LCOSetup, LCOSweep
 from aeroservo.system.hinge_elements import NonlinearHinge, hinge_elements
 
 RHO = 1.225

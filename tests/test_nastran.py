@@ -1,5 +1,5 @@
 """Nastran beam models in (issue 27, item 3): ``aeroservo import nastran`` and
-``aeroservo.files.nastran.import_nastran``.
+``aeroservo.files.nastran.importer.import_nastran``.
 
 Decks are written by the test itself with pyNastran's writer from randomized wings (segments
 with sweep kinks, concentrated masses with CG offsets and inertias, right and left wings, grids
@@ -27,8 +27,8 @@ pytest.importorskip(
 )
 
 from aeroservo.errors import InputError  # noqa: E402
-from aeroservo.files.nastran import import_nastran, read_nastran  # noqa: E402
-from aeroservo.files.nastran_deck import pynastran_bdf  # noqa: E402
+from aeroservo.files.nastran.deck import pynastran_bdf  # noqa: E402
+from aeroservo.files.nastran.importer import import_nastran, read_nastran  # noqa: E402
 from aeroservo.files.wing_file import load_wing  # noqa: E402
 from aeroservo.structure.wing import ConcentratedMass, Segment, Wing  # noqa: E402
 from aeroservo.system.aeroelastic import AeroelasticModel  # noqa: E402

@@ -41,8 +41,8 @@ pytest.importorskip(
 
 from aeroservo.cli import main  # noqa: E402
 from aeroservo.errors import InputError  # noqa: E402
-from aeroservo.files.nastran import read_nastran  # noqa: E402
-from aeroservo.files.nastran_deck import pynastran_bdf  # noqa: E402
+from aeroservo.files.nastran.deck import pynastran_bdf  # noqa: E402
+from aeroservo.files.nastran.importer import read_nastran  # noqa: E402
 from aeroservo.files.wing_file import load_wing  # noqa: E402
 from aeroservo.system.aeroelastic import AeroelasticModel  # noqa: E402
 
@@ -516,7 +516,7 @@ def test_chord_implausible_for_the_units_one_line(tmp_path):
 
 def test_cli_unit_names_are_the_unit_systems():
     from aeroservo.cli.importing import UNIT_NAMES
-    from aeroservo.files.nastran_units import UNIT_SYSTEMS
+    from aeroservo.files.nastran.units import UNIT_SYSTEMS
 
     assert tuple(UNIT_NAMES) == tuple(UNIT_SYSTEMS)
 

@@ -22,9 +22,9 @@ import pytest
 
 import aeroservo as aes
 from aeroservo.linear.signals import station_output
-from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
-from aeroservo.studies.gust_run import run_gust_loads
-from aeroservo.studies.one_g import one_g_loads, wing_weight
+from aeroservo.studies.gust.one_g import one_g_loads, wing_weight
+from aeroservo.studies.gust.run import run_gust_loads
+from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
 
 G = 9.80665
 Q = ("shear", "bending_moment", "torque")

@@ -31,12 +31,12 @@ from aeroservo.files import load_scenario
 from aeroservo.files.flutter_table import flutter_table
 from aeroservo.linear.hinge_plant import section_plant
 from aeroservo.result_shape import Result
-from aeroservo.simulate.hinge_march import march_hinges
+from aeroservo.simulate.hinges.march import march_hinges
 from aeroservo.stability.boundary import flutter_boundary
 from aeroservo.structure.hinge_laws import Freeplay
 from aeroservo.studies.envelope import flutter_envelope
-from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
-from aeroservo.studies.gust_run import run_gust_loads
+from aeroservo.studies.gust.run import run_gust_loads
+from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
 from aeroservo.studies.recovery import recoverable_set
 from aeroservo.studies.runs import run_scenario
 from aeroservo.studies.scenario import quick

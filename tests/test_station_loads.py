@@ -28,7 +28,7 @@ import scipy.linalg as sla
 
 import aeroservo as aes
 from aeroservo.linear.signals import station_output
-from aeroservo.studies.gust_loads import FlightPoint, GustLoadsStudy
+from aeroservo.studies.gust.study import FlightPoint, GustLoadsStudy
 
 QUANTITIES = ("shear", "bending_moment", "torque")
 
@@ -225,7 +225,7 @@ def test_gust_loads_study_reports_the_stations():
         "bending_moment_at_1500mm",
         "torque_at_1500mm",
     )
-    from aeroservo.studies.gust_point import evaluate_point
+    from aeroservo.studies.gust.point import evaluate_point
 
     res = evaluate_point(study, study.points[0])
     ext = res.discrete["open"].extremes
@@ -243,8 +243,8 @@ def test_rigid_ratio_is_near_one_for_a_stiff_wing_and_above_for_goland():
     alleviation factor: the wing is clamped): a wing 1e4 times stiffer gives the quasi-static
     strip load less the Kussner lag in the longest gust (0.7 %, as the root check of
     docs/gust-loads.md), the Goland wing its aeroelastic amplification (1.14-1.20)."""
-    from aeroservo.studies.gust_run import run_gust_loads
-    from aeroservo.studies.rigid_gust import rigid_gust_loads
+    from aeroservo.studies.gust.rigid_wing import rigid_gust_loads
+    from aeroservo.studies.gust.run import run_gust_loads
 
     loads = ("root_shear", "root_bending_moment", "root_torque", "tip_le_accel")
     ratios = {}

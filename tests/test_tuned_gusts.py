@@ -32,7 +32,7 @@ from aeroservo.aero.gust_rules import (
     reference_gust_velocity,
 )
 from aeroservo.errors import InputError
-from aeroservo.studies.tuned_gusts import one_minus_cosine_response, tuned_gust_loads
+from aeroservo.studies.gust.tuned import one_minus_cosine_response, tuned_gust_loads
 
 FT = 0.3048  # international foot, exact
 LOADS = ["root_shear", "root_bending_moment", "root_torque"]

@@ -11,7 +11,7 @@ from scipy import integrate, linalg, signal
 
 import aeroservo as aes
 from aeroservo.errors import InputError
-from aeroservo.studies.turbulence import dryden, turbulence_response, u_sigma, von_karman
+from aeroservo.studies.gust.turbulence import dryden, turbulence_response, u_sigma, von_karman
 
 V = 120.0
 L = 762.0

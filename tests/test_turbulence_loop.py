@@ -31,8 +31,8 @@ from aeroservo.design.sampled_loop import linear_law, plant_states
 from aeroservo.errors import InputError
 from aeroservo.files import load_controller
 from aeroservo.simulate import simulate
-from aeroservo.studies.turbulence import _sampled_loop, dryden, turbulence_response, von_karman
-from aeroservo.studies.turbulence_loop import (
+from aeroservo.studies.gust.turbulence import _sampled_loop, dryden, turbulence_response, von_karman
+from aeroservo.studies.gust.turbulence_loop import (
     ModalResponse,
     adaptive,
     breakpoints,

@@ -14,7 +14,7 @@ The rule is written in feet; the feet appear here only in the table constants, c
 international foot (1 ft = 0.3048 m exactly, :data:`aeroservo.aero.atmosphere.FT`). Altitudes
 are pressure altitudes [m] (the ISA geopotential altitude of :func:`aeroservo.aero.atmosphere.isa`).
 The gust profile itself is ``U(s) = U_ds / 2 (1 - cos(pi s / H))`` over ``0 <= s <= 2 H``
-(:mod:`aeroservo.studies.tuned_gusts`).
+(:mod:`aeroservo.studies.gust.tuned`).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ import argparse
 from .options import quantity
 
 UNIT_NAMES = ("si", "in-lbf-s", "ft-slug-s", "mm-t-s")
-"""The unit systems of ``--units`` (``files/nastran_units.UNIT_SYSTEMS``, not imported here to
+"""The unit systems of ``--units`` (``files/nastran/units.UNIT_SYSTEMS``, not imported here to
 keep the parser free of numpy)."""
 
 __all__ = ["add_parsers", "HANDLERS"]
@@ -75,7 +75,7 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_import(args: argparse.Namespace) -> int:
-    from ..files.nastran import write_nastran_wing
+    from ..files.nastran.importer import write_nastran_wing
 
     result = write_nastran_wing(
         args.deck,
@@ -89,7 +89,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
     )
     print(f"wrote {args.out}: {result.summary}")
     if result.scenario is not None:
-        from ..files.nastran import scenario_path
+        from ..files.nastran.importer import scenario_path
 
         print(
             f"wrote {scenario_path(args.out)}: run it with 'aeroservo flutter "

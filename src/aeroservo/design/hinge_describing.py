@@ -9,7 +9,7 @@ loop_hinge_plant`: ``x' = A x + B u + B_n phi``, ``y = C x + D u + D_n phi`` wit
 ``C + D_n diag(k - N) C_n`` is sampled with a zero-order hold on the command only (the hinge
 moments act continuously, as in the march) and closed with the controller's linear law: the
 transition matrix ``M(V, A)`` of :func:`~aeroservo.design.sampled_loop.loop_matrix`, the loop
-:func:`~aeroservo.simulate.hinge_march.march_hinges` marches (limits inactive). An LCO of
+:func:`~aeroservo.simulate.hinges.march.march_hinges` marches (limits inactive). An LCO of
 amplitude ``A`` is a speed where ``M`` has a root ``mu`` on the unit circle. The method is the
 open loop's, on the growth rates ``ln|mu| / dt`` [1/s] of the sampled loop:
 

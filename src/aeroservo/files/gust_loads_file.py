@@ -1,4 +1,4 @@
-"""Gust-loads result files: a :class:`~aeroservo.studies.gust_results.GustLoadsResult` as
+"""Gust-loads result files: a :class:`~aeroservo.studies.gust.results.GustLoadsResult` as
 ``<stem>.json`` (the run's summary, the study's settings, the load units and every record) and
 ``<stem>.npz`` (the time histories of the critical gusts), with the limit-load table
 ``<stem>.csv`` and, when both loops were run, the gust-load-alleviation table
@@ -18,7 +18,7 @@ import numpy as np
 
 from ..atomic import atomic_write_set
 from ..errors import InputError
-from ..studies.gust_results import GustLoadsResult
+from ..studies.gust.results import GustLoadsResult
 from .summaries import json_text
 from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
 
@@ -138,14 +138,14 @@ def write_gust_loads(
         The ``.json`` file; the ``.npz``, ``.csv``, ``_histories.csv`` and
         ``_alleviation.csv`` go next to it.
     summary : dict, optional
-        The run's summary (default :func:`aeroservo.studies.gust_scenario.gust_summary`).
+        The run's summary (default :func:`aeroservo.studies.gust.scenario.gust_summary`).
 
     Returns
     -------
     dict
         ``{kind: path}`` of the files written.
     """
-    from ..studies.gust_scenario import gust_summary
+    from ..studies.gust.scenario import gust_summary
 
     path = json_output(path, "gust-loads result (.json)")
     items = gust_loads_items(result, path, summary or gust_summary(result))

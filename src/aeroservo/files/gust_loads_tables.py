@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..aero.gust_rules import U_REF_TABLE, Z_REF
 from ..errors import InputError
-from ..studies.gust_loads import SPEED_NAMES, FlightPoint
+from ..studies.gust.study import SPEED_NAMES, FlightPoint
 from ..studies.scenario import Scenario
 from ..studies.study_options import GustLoadsOptions
 from .scenario_tables import controller, is_file

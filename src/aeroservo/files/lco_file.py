@@ -1,4 +1,4 @@
-"""Limit-cycle result files: an :class:`~aeroservo.studies.lco_result.LCOResult` as
+"""Limit-cycle result files: an :class:`~aeroservo.studies.lco.result.LCOResult` as
 ``<stem>.json`` (the run's summary, the study's settings, every march's verdict without its
 time history, the describing-function branches and the summary text), ``<stem>_histories.npz``
 (the end of each march: ``row<i>/t`` [s] and ``row<i>/<signal>``, rows numbered as in the
@@ -21,7 +21,7 @@ import numpy as np
 
 from ..atomic import atomic_write_set
 from ..errors import InputError
-from ..studies.lco_result import TABLE_COLUMNS, LCOResult
+from ..studies.lco.result import TABLE_COLUMNS, LCOResult
 from .summaries import finite, json_text
 from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
 
@@ -155,14 +155,14 @@ def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) 
     path : str or Path
         The ``.json`` file; the other files go next to it.
     summary : dict, optional
-        The run's summary (default :func:`aeroservo.studies.lco_scenario.lco_summary`).
+        The run's summary (default :func:`aeroservo.studies.lco.scenario.lco_summary`).
 
     Returns
     -------
     dict
         ``{kind: path}`` of the files written.
     """
-    from ..studies.lco_scenario import lco_summary
+    from ..studies.lco.scenario import lco_summary
 
     if not isinstance(result, LCOResult):
         raise InputError(f"result = {type(result).__name__}: expected an aeroservo LCOResult")

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..simulate.hinge_march import MAX_HINGE_SAMPLES
+from ..simulate.hinges.march import MAX_HINGE_SAMPLES
 from ..studies.scenario import Scenario
 from ..studies.study_options import LCOOptions
 from .hinge_tables import check_targets, hinges_from_list

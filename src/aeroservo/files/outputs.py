@@ -136,14 +136,14 @@ def _study_files(items_of, figures):
 
 
 def _gust_loads_files(run: Run, out: Path, add, files: dict) -> None:
-    from ..studies.gust_scenario import gust_figures
+    from ..studies.gust.scenario import gust_figures
     from .gust_loads_file import gust_loads_items
 
     return _study_files(gust_loads_items, gust_figures)(run, out, add, files)
 
 
 def _lco_files(run: Run, out: Path, add, files: dict) -> None:
-    from ..studies.lco_scenario import lco_figures
+    from ..studies.lco.scenario import lco_figures
     from .lco_file import lco_items
 
     return _study_files(lco_items, lco_figures)(run, out, add, files)

@@ -5,8 +5,8 @@ limits (:mod:`.march`), and the time histories it produces (:mod:`.result`).
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
-    "march_hinges": "hinge_march",
-    "HingeSimulation": "hinge_march",
+    "march_hinges": "hinges.march",
+    "HingeSimulation": "hinges.march",
     "classify": "lco_detect",
     "LCOVerdict": "lco_detect",
     "SimulationResult": "result",

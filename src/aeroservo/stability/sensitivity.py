@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 from ..errors import InputError
 from ..system.aeroelastic import AeroelasticModel
 from ..system.damping import damping_parameters
+from .eigen_derivatives import Terms
 from .parameters import TIE, TOUCH, _tie, parameter_values, with_parameters
 from .result import FlutterResult
-from .sensitivity_terms import Terms
 
 __all__ = [
     "FlutterSensitivities",

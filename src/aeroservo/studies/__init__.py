@@ -1,24 +1,25 @@
 """Studies: scenarios (:mod:`.scenario`) and their runs (:mod:`.runs`), trade studies over
 design and controller parameters on Dask (:mod:`.trade`), gust loads of CS-25.341 over
-flight points (:mod:`.gust_loads`, :mod:`.gust_run`).
+flight points (:mod:`.gust`), limit cycles of nonlinear hinges (:mod:`.lco`); the registry of
+scenario kinds (:mod:`.kinds`).
 """
 
 from .._lazy import lazy_attributes
 
 _PUBLIC = {
-    "LCOSetup": "lco",
-    "LCOSweep": "lco",
-    "LCOResult": "lco_result",
-    "run_lco": "lco_run",
+    "LCOSetup": "lco.study",
+    "LCOSweep": "lco.study",
+    "LCOResult": "lco.result",
+    "run_lco": "lco.run",
     "Run": "kinds",
     "Scenario": "scenario",
     "quick": "scenario",
     "run_scenario": "kinds",
-    "tuned_gust_loads": "tuned_gusts",
-    "turbulence_response": "turbulence",
-    "FlightPoint": "gust_loads",
-    "GustLoadsStudy": "gust_loads",
-    "run_gust_loads": "gust_run",
+    "tuned_gust_loads": "gust.tuned",
+    "turbulence_response": "gust.turbulence",
+    "FlightPoint": "gust.study",
+    "GustLoadsStudy": "gust.study",
+    "run_gust_loads": "gust.run",
 }
 
 __all__ = [

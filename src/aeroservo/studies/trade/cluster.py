@@ -12,11 +12,7 @@ from pathlib import Path
 
 from ...atomic import atomic_write, atomic_write_text
 from ...errors import InputError, check_int, check_number
-from .cases import _blank, evaluate_case
-from .grid import _digest, study_settings, trade_cases
-from .results import TradeResult, _assemble
-from .study import FORMAT, TradeStudy
-from .workers import (
+from ..dask_runner import (
     LostWorkers,
     _worker_probe,  # noqa: F401 (tests import it from here)
     check_address,
@@ -24,6 +20,10 @@ from .workers import (
     local_cluster,
     quiet_distributed,
 )
+from .cases import _blank, evaluate_case
+from .grid import _digest, study_settings, trade_cases
+from .results import TradeResult, _assemble
+from .study import FORMAT, TradeStudy
 
 __all__ = ["local_cluster", "run_trade"]
 
@@ -90,8 +90,8 @@ def run_trade(
         version of aeroservo. Default: a local cluster of ``workers`` processes.
     workers : int
         Worker processes of the local cluster (as ``workers`` of
-        :func:`~aeroservo.studies.gust_run.run_gust_loads` and
-        :func:`~aeroservo.studies.lco_run.run_lco`; a trade study runs on at least one).
+        :func:`~aeroservo.studies.gust.run.run_gust_loads` and
+        :func:`~aeroservo.studies.lco.run.run_lco`; a trade study runs on at least one).
     progress : bool
         Show a tqdm progress bar over the cases as they finish.
     timeout : float
