@@ -10,17 +10,22 @@ result (the figures redraw from it). No pickled objects: a damaged or foreign fi
 from __future__ import annotations
 
 import io
-import json
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_set
 from ..errors import InputError
 from ..studies.gust.results import GustLoadsResult
 from .summaries import json_text
-from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
+from .user_files import (
+    MAX_RESULT_BYTES,
+    json_of_format,
+    json_output,
+    read_bytes,
+    read_result_json,
+    write_result_items,
+)
 
 __all__ = [
     "FORMAT",
@@ -148,9 +153,7 @@ def write_gust_loads(
     from ..studies.gust.scenario import gust_summary
 
     path = json_output(path, "gust-loads result (.json)")
-    items = gust_loads_items(result, path, summary or gust_summary(result))
-    atomic_write_set(list(items.values()))
-    return {k: str(p) for k, (p, _w) in items.items()}
+    return write_result_items(gust_loads_items(result, path, summary or gust_summary(result)))
 
 
 def is_gust_loads_file(path: str | Path) -> bool:
@@ -172,20 +175,7 @@ def load_gust_loads(path: str | Path) -> GustLoadsResult:
     InputError
         The file is missing, not a gust-loads result, or its NPZ is missing or incomplete.
     """
-    path = user_path(path, "gust-loads result (.json)")
-    raw = read_bytes(path, what="gust-loads result (.json)", limit=MAX_RESULT_BYTES)
-    try:
-        doc = json.loads(raw.decode("utf-8-sig"))
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
-        _fail(path, f"not JSON: {' '.join(str(exc).split())}")
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else None
-        older = (
-            " (written by an older aeroservo: run the study again)"
-            if found == ("aeroservo-gust-loads-1")
-            else ""
-        )
-        _fail(path, f"format {found!r}, expected {FORMAT!r}{older}")
+    path, doc = read_result_json(path, "gust-loads result", FORMAT, ("aeroservo-gust-loads-1",))
     records = doc.get("records")
     if not isinstance(records, list) or not all(
         isinstance(r, dict) and all(k in r for k in _RECORD_KEYS) for r in records

@@ -12,18 +12,23 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_set
 from ..errors import InputError
 from ..studies.lco.result import TABLE_COLUMNS, LCOResult
 from .summaries import finite, json_text
-from .user_files import MAX_RESULT_BYTES, json_of_format, json_output, read_bytes, user_path
+from .user_files import (
+    MAX_RESULT_BYTES,
+    json_of_format,
+    json_output,
+    read_bytes,
+    read_result_json,
+    write_result_items,
+)
 
 __all__ = ["FORMAT", "lco_items", "write_lco", "load_lco", "is_lco_file", "TABLE_UNITS"]
 
@@ -167,9 +172,7 @@ def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) 
     if not isinstance(result, LCOResult):
         raise InputError(f"result = {type(result).__name__}: expected an aeroservo LCOResult")
     path = json_output(path, "limit-cycle result (.json)")
-    items = lco_items(result, path, summary or lco_summary(result))
-    atomic_write_set(list(items.values()))
-    return {k: str(p) for k, (p, _w) in items.items()}
+    return write_result_items(lco_items(result, path, summary or lco_summary(result)))
 
 
 def is_lco_file(path: str | Path) -> bool:
@@ -194,15 +197,7 @@ def load_lco(path: str | Path) -> LCOResult:
     """
     from ..stability.describing_function import DescribingBranches
 
-    path = user_path(path, "limit-cycle result (.json)")
-    raw = read_bytes(path, what="limit-cycle result (.json)", limit=MAX_RESULT_BYTES)
-    try:
-        doc = json.loads(raw.decode("utf-8-sig"))
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
-        _fail(path, f"not JSON: {' '.join(str(exc).split())}")
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        found = doc.get("format") if isinstance(doc, dict) else None
-        _fail(path, f"format {found!r}, expected {FORMAT!r}")
+    path, doc = read_result_json(path, "limit-cycle result", FORMAT)
     rows, settings = doc.get("rows"), doc.get("settings")
     if not isinstance(rows, list) or not all(
         isinstance(r, dict) and all(k in r for k in TABLE_COLUMNS) for r in rows

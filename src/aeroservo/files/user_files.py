@@ -157,3 +157,35 @@ def json_of_format(path: str | Path, fmt: str) -> bool:
     except (OSError, ValueError):
         return False
     return f'"format": "{fmt}"'.encode() in head
+
+
+def write_result_items(items: dict) -> dict[str, str]:
+    """Write the files of a result (``{kind: (path, writer)}``) as one set, all or none;
+    returns ``{kind: path}``."""
+    from ..atomic import atomic_write_set
+
+    atomic_write_set(list(items.values()))
+    return {k: str(p) for k, (p, _w) in items.items()}
+
+
+def read_result_json(path: str | Path, what: str, fmt: str, older: tuple = ()) -> tuple:
+    """``(path, document)`` of a result written as JSON in the format ``fmt``: an InputError
+    naming the file and ``what`` it should be when it is missing, too large, not JSON, not a
+    table or of another format (``older``: formats of earlier versions, named as such)."""
+    import json
+
+    path = user_path(path, f"{what} (.json)")
+    raw = read_bytes(path, what=f"{what} (.json)", limit=MAX_RESULT_BYTES)
+
+    def fail(why: str):
+        raise InputError(f"{path}: not a valid aeroservo {what} ({why})")
+
+    try:
+        doc = json.loads(raw.decode("utf-8-sig"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        fail(f"not JSON: {' '.join(str(exc).split())}")
+    if not isinstance(doc, dict) or doc.get("format") != fmt:
+        found = doc.get("format") if isinstance(doc, dict) else None
+        again = " (written by an older aeroservo: run the study again)" if found in older else ""
+        fail(f"format {found!r}, expected {fmt!r}{again}")
+    return path, doc
