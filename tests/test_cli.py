@@ -154,7 +154,6 @@ FLUTTER_MODULES = {
             ".analysis",
             ".envelope",
             ".importing",
-            ".lco",
             ".options",
             ".optimize",
             ".results",

@@ -76,9 +76,10 @@ def finite(obj: object) -> object:
 
 
 def json_text(obj: object, indent: int | None = 2) -> str:
-    """JSON text of ``obj``: numpy scalars and arrays become plain numbers and lists, anything
-    else unknown its ``str``."""
-    return json.dumps(obj, indent=indent, default=_plain)
+    """Standard JSON text of ``obj``: numpy scalars and arrays become plain numbers and lists,
+    non-finite numbers ``null`` (not the bare ``NaN`` / ``Infinity`` that JSON does not have),
+    anything else unknown its ``str``."""
+    return json.dumps(finite(obj), indent=indent, default=_plain, allow_nan=False)
 
 
 class Result:

@@ -166,7 +166,9 @@ def _cmd_flutter(args: argparse.Namespace) -> int:
     for w in dict.fromkeys(result.warnings + (pk.warnings if pk is not None else [])):
         print(f"aeroservo: warning: {w}", file=sys.stderr)
     if args.json:
-        print(json.dumps(out, indent=2))
+        from ..result_shape import json_text
+
+        print(json_text(out))
         return 0
     if model.dlm is None:
         print(f"{wing.name}: {model.n_elements} elements, Wagner '{model.wagner.name}'")
