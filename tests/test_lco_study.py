@@ -19,6 +19,9 @@ R. T. Jones lag states): the marches against the describing function, and the sc
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -28,6 +31,8 @@ from aeroservo.studies.lco.run import run_lco
 from aeroservo.studies.lco.study import LCOSetup, LCOSweep
 from aeroservo.system.hinge_elements import NonlinearHinge
 from aeroservo.system.section import CONNER, conner_section
+
+ROOT = Path(__file__).resolve().parent.parent
 
 GAP = CONNER["gap"]
 U_F = 23.73  # m/s, gap closed, R. T. Jones (reference README)
@@ -116,3 +121,31 @@ def test_continuation_sweeps_and_the_summary():
     text = res.summary()
     assert "limit cycles from 10 to 10 m/s" in text
     assert "divergent motion from 26 m/s" in text
+
+
+def test_a_surface_resting_at_a_gap_edge_is_said_with_its_offset(tmp_path):
+    """Issue 40 item 4: a march that decays against an edge of the gap (here a preloaded
+    freeplay, centre 0.05 rad > half the 0.074 rad gap, so the spring holds the flap at the
+    lower edge) is not a plain decay: its reason says 'rest at the lower edge' and the offset
+    from the gap's centre, -0.5 x gap (the spring slightly compressed)."""
+    from dataclasses import replace
+
+    from aeroservo.files.scenario_file import load_scenario
+    from aeroservo.studies.kinds import run_scenario
+
+    src = ROOT / "scenarios" / "conner_freeplay_lco.toml"
+    text = src.read_text().replace("offset = 0.0 ", "offset = 0.05")
+    (tmp_path / "edge.toml").write_text(text)
+    sc = load_scenario(tmp_path / "edge.toml")
+    opts = replace(
+        sc.lco, speeds=(15.0,), amplitudes=(0.0185,), duration=2.0, history=0.5,
+        continuation=False, describing=False,
+    )  # fmt: skip
+    (row,) = run_scenario(replace(sc, options=opts)).lco.rows
+    assert row["kind"] == "decay"
+    m = re.search(
+        r"rest at the lower edge of the gap: offset (\S+) rad \((\S+) x gap\)", row["reason"]
+    )
+    assert m, row["reason"]
+    assert float(m.group(2)) == pytest.approx(-0.5, abs=0.03)
+    assert float(m.group(1)) == pytest.approx(row["mean"] - 0.05, rel=1e-3)

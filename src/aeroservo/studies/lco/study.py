@@ -215,6 +215,13 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
             what = f"grows, largest rotation {reach / gap:.3g} x gap: march longer to see where"
             what += " it settles"
         reason = what + "; " + reason
+    rest = float(verdict.mean[ref]) - _centre(setup)
+    if kind_ == "decay" and gap and abs(rest) >= EDGE * 0.5 * gap:
+        side = "upper" if rest > 0 else "lower"
+        reason = (
+            f"rest at the {side} edge of the gap: offset {rest:.4g} rad ({rest / gap:+.3g} x "
+            f"gap) from its centre; {reason}"
+        )
     row = {
         "start": kind,
         "speed": float(speed),
@@ -236,6 +243,11 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
         "history": hist,
     }
     return row
+
+
+EDGE = 0.98
+"""A march that decays to a mean rotation beyond this share of the half gap rests against the
+gap's edge (the spring engaged or just touched), not at its centre."""
 
 
 def _centre(setup) -> float:
