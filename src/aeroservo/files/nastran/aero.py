@@ -33,6 +33,9 @@ AERO_CARDS = (
 )  # fmt: skip
 """Aerodynamic and flutter cards read."""
 
+MAX_BOXES = 100_000
+"""Most boxes a CAERO1 may have (NSPAN x NCHORD; a wing's panel has tens to a few thousand)."""
+
 PK_METHODS = ("PK", "PKNL", "PKS", "PKNLS")
 """FLUTTER methods that list velocities (the others, K and KE, list reduced frequencies)."""
 
@@ -274,6 +277,12 @@ def check_aero_references(path: Path, model) -> None:
     for eid, caero in sorted(model.caeros.items()):
         if caero.pid not in model.paeros:
             raise InputError(f"{path}: CAERO1 {eid}: PAERO1 {caero.pid} is missing")
+        boxes = int(caero.nspan or 1) * int(caero.nchord or 1)
+        if boxes > MAX_BOXES:  # pyNastran numbers them in one array when cross-referencing
+            raise InputError(
+                f"{path}: CAERO1 {eid}: NSPAN = {caero.nspan}, NCHORD = {caero.nchord}: "
+                f"{boxes} boxes, more than the {MAX_BOXES} a panel may have"
+            )
         for key in ("lspan", "lchord"):
             fid = getattr(caero, key, 0)
             if fid and fid not in model.aefacts:

@@ -37,7 +37,7 @@ from ...errors import InputError, check_number, check_quantity
 from ..toml_tables import read_toml
 from .deck import vector_text
 
-__all__ = ["ImportOptions", "SpanValues", "import_options", "VALUE_KEYS"]
+__all__ = ["ImportOptions", "SpanValues", "import_options", "check_sections", "VALUE_KEYS"]
 
 VALUE_KEYS = ("semichord", "a", "x_alpha", "inertia", "mass")
 """Section values a companion table (or an option) may give [SI]."""
@@ -209,3 +209,35 @@ def import_options(
             f"{vector_text(opts.up)}: the flow must lie in the wing's plane"
         )
     return opts
+
+
+def check_sections(opts: ImportOptions, midpoints: list[float], span: float, units) -> None:
+    """Refuse a ``[[sections]]`` interval that ends beyond the tip (by more than 1 %) or holds
+    no element's midpoint: its values would apply nowhere, silently (a table written for
+    another wing, or in the deck's units rather than in metres).
+
+    Parameters
+    ----------
+    opts : ImportOptions
+        The resolved options (their companion table named in the message).
+    midpoints : list of float
+        The elements' midpoints along the beam line [m].
+    span : float
+        The beam line's length [m].
+    units : UnitSystem
+        The deck's units (named in the message).
+    """
+    read = "SI" if units.name == "si" else f"{units.name} converted to SI"
+    for i, sec in enumerate(opts.sections):
+        where = f"{opts.companion}: sections[{i}]"
+        if sec.end > 1.01 * span:
+            raise InputError(
+                f"{where}.end = {sec.end:g} m: beyond the tip, the beam line is {span:.6g} m "
+                f"long (the deck read as {read}; the table is in metres)"
+            )
+        if not any(sec.start <= x <= sec.end for x in midpoints):
+            raise InputError(
+                f"{where} ({sec.start:g} to {sec.end:g} m) holds no element's midpoint: its "
+                "values would apply to no element (each element takes the values at its "
+                "midpoint); widen it"
+            )

@@ -50,6 +50,9 @@ SUPPORTED = (
 )
 """Cards mapped to the wing, its aerodynamic grid and its flutter case."""
 
+MAX_ELEMENTS = 10_000
+"""Most beam elements a deck may have (a stick model has tens to a few hundred)."""
+
 IGNORED = ("PARAM", "EIGRL", "EIGR", "EIGC", "SPCADD", "MDLPRM", "ENDDATA")
 """Cards accepted and left out silently (solution control; ``PARAM,WTMASS`` scales the masses,
 ``PARAM,LMODES`` sets the doublet lattice's modes)."""
@@ -225,6 +228,11 @@ def _check_cards(path: Path, model) -> str:
         )
     if not model.elements:
         raise InputError(f"{path}: no CBAR or CBEAM element: nothing to import")
+    if len(model.elements) > MAX_ELEMENTS:
+        raise InputError(
+            f"{path}: {len(model.elements)} beam elements, more than the {MAX_ELEMENTS} of a "
+            "stick model"
+        )
     return ", ".join(f"{c} ({counts[c]})" for c in sorted(counts) if c in NOTED)
 
 
@@ -275,7 +283,15 @@ def _extract(path: Path, model, units: UnitSystem) -> Deck:
     param = model.params.get("WTMASS")
     if param is not None:
         wtmass = float(param.values[0])
+        if not wtmass > 0.0:  # a NaN too
+            raise InputError(
+                f"{path}: PARAM WTMASS = {wtmass:g}: must be > 0 (it multiplies every mass, "
+                "inertia and density: 1, or 1/386.09 for masses in lbm)"
+            )
         notes.append(f"PARAM,WTMASS,{wtmass:g} scales every mass and inertia")
+    for mid, mat in sorted(model.materials.items()):
+        if float(getattr(mat, "rho", 0.0) or 0.0) < 0.0:
+            raise InputError(f"{path}: {mat.type} {mid}: RHO = {mat.rho:g}: a density must be >= 0")
     grids = {
         nid: np.asarray(g.get_position(), dtype=float) * units.length
         for nid, g in model.nodes.items()

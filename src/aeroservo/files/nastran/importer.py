@@ -27,9 +27,10 @@ from .case import (
     scenario_text,
     surface_geometry,
 )
-from .companion import import_options
+from .companion import check_sections, import_options
 from .deck import read_deck
-from .units import chord_hint
+from .reader import same_file, scan_deck
+from .units import chord_hint, span_hint
 from .wing_masses import point_masses
 
 __all__ = [
@@ -109,6 +110,9 @@ def read_nastran(
     if aero is not None and not _given_flow(opts):
         opts = replace(opts, free_stream=aero.flow)
     root, line = beam_line(data, opts)
+    check_sections(opts, [0.5 * (be.start + be.end) for be in line], line[-1].end, data.units)
+    mass, heaviest = _deck_mass(data, line)
+    span_hint(path, line[-1].end, mass, data.units, _given_mass(opts), heaviest)
     geometry, surface_geo = {}, {}
     if aero is not None:
         geometry = panel_geometry(path, aero, line, data.grids, opts.up)
@@ -190,7 +194,9 @@ def write_nastran_wing(deck: str | Path, out: str | Path, **options) -> NastranI
     from ...atomic import atomic_write_set, check_output_path
 
     check_output_path(out, "--out")
+    included = scan_deck(deck)[1][1:]  # the deck checked before anything is computed
     inputs = {"the deck": deck, "the companion table": options.get("companion")}
+    inputs |= {f"a file the deck INCLUDEs ({f.name})": f for f in included}
     _not_an_input("--out", out, inputs)
     result = read_nastran(deck, wing_file=Path(out).name, **options)
     files = [(Path(out), result.text)]
@@ -225,10 +231,29 @@ def _unit_text(exc: InputError, units) -> str:
 
 
 def _not_an_input(what: str, out: Path | str, inputs: dict) -> None:
-    """Refuse an output that would overwrite an input file."""
+    """Refuse an output that would overwrite an input file (the same path, through links)."""
     for name, path in inputs.items():
-        if path is not None and Path(out).resolve() == Path(path).resolve():
+        if path is not None and same_file(out, path):
             raise InputError(f"{what} = {out}: that is {name}; name another file")
+
+
+def _deck_mass(data, line) -> tuple[float, str]:
+    """The mass the deck gives its beam line [kg] (its sections' and its mass cards') and the
+    card that gives more than half of it ('' if none)."""
+    parts = {f"{pm.card} {pm.eid} at GRID {pm.grid}": pm.mass for pm in data.masses}
+    for be in line:
+        sec = be.element.section
+        parts[sec.label] = parts.get(sec.label, 0.0) + (sec.rho * sec.A + sec.nsm) * (
+            be.end - be.start
+        )
+    total = sum(parts.values())
+    big = max(parts, key=parts.get) if parts else ""
+    return total, big if big and parts[big] > 0.5 * total else ""
+
+
+def _given_mass(opts) -> bool:
+    """Whether the options or the companion table give a mass per length."""
+    return "mass" in opts.defaults or any("mass" in s.values for s in opts.sections)
 
 
 def _given_flow(opts) -> bool:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from ...errors import InputError
 
-__all__ = ["UnitSystem", "UNIT_SYSTEMS", "unit_system", "unit_hint", "chord_hint"]
+__all__ = ["UnitSystem", "UNIT_SYSTEMS", "unit_system", "unit_hint", "chord_hint", "span_hint"]
 
 LBF = 4.4482216152605
 """One pound-force [N] (exact by the 1959 definition: 0.45359237 kg x 9.80665 m/s^2)."""
@@ -193,4 +193,77 @@ def chord_hint(path, span: float, segments, sources, units: UnitSystem) -> None:
         f"{path}: the beam is {span:.4g} m long in {units.name} units and the chord given is "
         f"{chord:.4g} m: {ratio:.3g} chords, outside the plausible [{lo:g}, {hi:g}]; {hint} "
         "(docs/nastran.md, 'Units')"
+    )
+
+
+SPAN_MAX = 200.0
+"""Longest beam line [m] taken as plausible (a semi-span or a rotor blade: the largest
+aircraft's semi-span is 59 m, the longest wind-turbine blades 120 m)."""
+
+MASS_PER_SPAN3 = (1e-5, 1e4)
+"""A beam line's mass over its length cubed [kg/m^3] taken as plausible: about 0.002 for a
+human-powered aircraft's wing, 0.05 for a wind-turbine blade, 0.5 for an airliner's, 10 for a
+solid metal wind-tunnel model; a deck read in units 25 times too long is 1e5 times lighter."""
+
+
+def _span_fits(span: float, mass: float | None) -> bool:
+    lo, hi = MASS_PER_SPAN3
+    return span <= SPAN_MAX and (mass is None or lo <= mass / span**3 <= hi)
+
+
+def span_hint(
+    path, span: float, mass: float, units: UnitSystem, mass_given: bool, heaviest: str = ""
+) -> None:
+    """Refuse a beam line whose length or mass is implausible for a wing in the units given
+    (a deck in mm read as SI is a wing kilometres long and as light as paper), naming the unit
+    system in which both are plausible.
+
+    Parameters
+    ----------
+    path
+        The deck (named in the message).
+    span : float
+        The beam line's length in SI [m], as read in ``units``.
+    mass : float
+        The mass the deck gives it [kg], as read in ``units`` (0: none, not checked).
+    units : UnitSystem
+        The units the user gave.
+    mass_given : bool
+        The options or companion table give the mass per length (SI): the deck's mass is
+        not checked.
+    heaviest : str
+        The card that gives most of the mass (named in the message), or ''.
+    """
+    mass = mass if mass > 0.0 and not mass_given else None
+    if _span_fits(span, mass):
+        return
+    fits = []
+    for u in UNIT_SYSTEMS.values():
+        s_u = span * u.length / units.length
+        m_u = None if mass is None else mass * u.mass / units.mass
+        if _span_fits(s_u, m_u):  # the likeliest first: nearest a 10 m wing of 0.1 kg/m^3
+            fits.append(
+                (abs(math.log10(s_u / 10.0 if m_u is None else m_u / s_u**3 / 0.1)), u.name)
+            )
+    fits = [name for _, name in sorted(fits)]
+    hint = (
+        f"the deck looks like {' or '.join(fits)} units: give --units {fits[0]}"
+        if fits
+        else "check the deck's units (--units) and PARAM WTMASS"
+    )
+    lo, hi = MASS_PER_SPAN3
+    what = (
+        f"longer than the {SPAN_MAX:g} m of any wing"
+        if span > SPAN_MAX
+        else f"mass / length^3 = {mass / span**3:.3g} kg/m^3, outside the plausible [{lo:g}, "
+        f"{hi:g}] of wings"
+    )
+    weighs = (
+        ""
+        if mass is None
+        else f" and weighs {mass:.4g} kg" + (f" (most of it {heaviest})" if heaviest else "")
+    )
+    raise InputError(
+        f"{path}: the beam line is {span:.4g} m long{weighs} in {units.name} units: {what}; "
+        f"{hint} (docs/nastran.md, 'Units')"
     )

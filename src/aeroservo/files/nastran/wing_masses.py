@@ -57,7 +57,7 @@ def point_masses(
             continue
         if pm.direction is not None:
             if abs(pm.direction @ up) >= math.cos(ORIENTATION_TOLERANCE):
-                masses.append(ConcentratedMass(station[pm.grid], pm.mass, name=label))
+                masses.append(_mass(deck, pm, station[pm.grid], pm.mass))
                 notes.append(f"{label}: vertical scalar mass at GRID {pm.grid}")
             elif abs(pm.direction @ up) <= math.sin(ORIENTATION_TOLERANCE):
                 left.append(f"{label} (in-plane: the wing has no in-plane motion)")
@@ -81,13 +81,14 @@ def point_masses(
         if pm.mass == 0.0:
             r = np.zeros(3)
         masses.append(
-            ConcentratedMass(
+            _mass(
+                deck,
+                pm,
                 min(x, span),
                 pm.mass,
                 offset=float(r @ be.aft),
                 inertia=max(inertia, 0.0),
                 vertical_offset=float(r @ up),
-                name=label,
             )
         )
         shift = f", CG {float(r @ be.span_dir):g} m outboard" if r @ be.span_dir else ""
@@ -107,7 +108,21 @@ def _matrix_mass(deck, pm, be: BeamElement, up: np.ndarray, x: float):
     if m_ww <= tol and m_pp <= tol:
         return None
     if m_ww <= tol:
-        return ConcentratedMass(x, 0.0, inertia=m_pp, name=f"{pm.card} {pm.eid}")
+        return _mass(deck, pm, x, 0.0, inertia=m_pp)
     y = -m_wp / m_ww
     inertia = max(m_pp - m_ww * y * y, 0.0)
-    return ConcentratedMass(x, m_ww, offset=y, inertia=inertia, name=f"{pm.card} {pm.eid}")
+    return _mass(deck, pm, x, m_ww, offset=y, inertia=inertia)
+
+
+def _mass(deck: Deck, pm, x: float, mass: float, **kw) -> ConcentratedMass:
+    """A :class:`ConcentratedMass` of a mass card; its checks name the deck and the card."""
+    label = f"{pm.card} {pm.eid}"
+    try:
+        return ConcentratedMass(x, mass, name=label, **kw)
+    except InputError as exc:
+        why = str(exc).replace(f"mass '{label}'.", "", 1)
+        read = "SI" if deck.units.name == "si" else f"{deck.units.name} converted to SI"
+        raise InputError(
+            f"{deck.path}: {label} at GRID {pm.grid}: {why} (the deck read as {read}, PARAM "
+            f"WTMASS = {deck.wtmass:g}: check --units)"
+        ) from None
