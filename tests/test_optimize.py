@@ -11,6 +11,7 @@ boundaries, and the Lagrange condition holds with central differences of the flu
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from conftest import ROOT
@@ -104,7 +105,7 @@ def test_bad_files(tmp_path, old, new, fragment):
     assert old in text
     p = tmp_path / "o.toml"
     p.write_text(text.replace(old, new))
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InputError, match=re.escape(fragment)) as info:
         p2 = load_optimization(p)
         optimize_wing(p2.wing, p2.density, p2.variables, p2.objective, p2.constraints)
     msg = str(info.value)
