@@ -335,6 +335,7 @@ def test_judge_loop_fails_a_loop_unstable_below_its_design_speed(setup):
     assert f"{lo:.4g}-{v_up:.4g} m/s ({u['kind']})" in line
 
 
+@pytest.mark.slow
 def test_scenario_unstable_in_its_engaged_range_fails_and_exits_3(tmp_path, capsys):
     """The shipped LQR (designed at 1.1 V_f, unstable below 43.5 m/s) engaged from 0.3 V_f: the
     run at 1.1 V_f is stable there, but its verdict is "unstable" and it does not pass; the
@@ -740,6 +741,7 @@ def _brought(path):
     return sc, loop.design_controller(sc.controller, 100.0, sc.sample_rate, VF)
 
 
+@pytest.mark.slow
 def test_brought_hinf_gives_the_margins_and_boundary_of_the_builtin_one(
     setup, builtin_hinf_run, tmp_path
 ):

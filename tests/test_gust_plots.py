@@ -90,6 +90,7 @@ def _ellipses(ax) -> list:
     return [ln for ln in ax.lines if len(ln.get_xdata()) > 100]
 
 
+@pytest.mark.slow
 def test_every_figure_has_its_panels(result, tmp_path):
     assert result.loops == ["open", "closed"]
     loads = result.loads

@@ -121,6 +121,7 @@ def test_bad_arguments(problem):
         optimize_wing(problem.wing, 1.225, problem.variables, {"segments[0].EI": 1.0}, {})
 
 
+@pytest.mark.slow
 def test_codesign_shipped_case(capsys):
     """Aileron chord and LQR Bryson weight for the highest closed-loop flutter speed under a
     600 N m gust hinge-moment limit: a better design than the start, the limit met on a fresh
@@ -169,6 +170,7 @@ def balance():
     }
 
 
+@pytest.mark.slow
 def test_mass_balance_least_balance_bracketed(balance):
     """The least balance (largest S_beta) with V_f >= 126.5 m/s (g = 0.02): the optimum meets
     the constraint on a fresh analysis, and 1e-3 kg m/m less balance breaks it (independent of
@@ -189,6 +191,7 @@ def test_mass_balance_least_balance_bracketed(balance):
     assert vf(s) >= 126.5 * (1 - 1e-6) and vf(s + 1e-3) < 126.5
 
 
+@pytest.mark.slow
 def test_negative_weights_keep_the_direction(balance):
     """A negative weight maximizes its variable, whatever the sign of the start (the
     objective is scaled by its magnitude, not its sign)."""

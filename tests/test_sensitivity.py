@@ -143,7 +143,14 @@ def _check(got, ref, value, base, what):
     )
 
 
-@pytest.mark.parametrize("name", CASES)
+FAST_CASES = ("goland", "goland_aileron", "hale")
+"""The cases ``make test-fast`` runs; the others (the corpus wings: building the corpus takes
+about 20 s) are marked slow."""
+
+
+@pytest.mark.parametrize(
+    "name", [n if n in FAST_CASES else pytest.param(n, marks=pytest.mark.slow) for n in CASES]
+)
 def test_against_central_differences(name):
     model, density, v_max = named_case(name)
     s = flutter_sensitivities(model, density, rtol=RTOL, v_max=v_max)
@@ -558,6 +565,7 @@ def test_actuator_at_a_surface_end_is_one_sided():
     assert "outboard" not in s.undefined[name]
 
 
+@pytest.mark.slow
 def test_damped_modes_at_rest_on_an_exact_eigenvalue():
     """Rayleigh damping on a corpus wing where the Rayleigh-quotient iteration lands on the
     eigenvalue exactly (a singular solve, found by review): the pair is returned."""
