@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install demo test lint bench bench-quick clean
+.PHONY: install demo test test-fast lint bench bench-quick clean
 
 install: $(STAMP)
 
@@ -33,6 +33,12 @@ lint: install
 test: lint
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
 		$(BIN)/python -m pytest -n 2 --dist loadscope
+
+# everyday work, under 2 minutes on the 2-core machine: every test module, without the tests
+# marked slow (over about 2 s each, or sharing a module fixture that is); `make test` runs all
+test-fast: install
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
+		$(BIN)/python -m pytest -n 2 --dist loadscope -m "not slow"
 
 # every target of the performance issues with its ratio to a same-run baseline and PASS/FAIL
 bench: install

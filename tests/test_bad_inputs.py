@@ -908,7 +908,8 @@ def test_fuzz_result_bytes(tmp_path_factory, raw, suffix):
 
     p = tmp_path_factory.mktemp("fuzz") / f"r{suffix}"
     p.write_bytes(raw)
-    with pytest.raises(InputError):
+    # the file named, and what it is not (an aeroservo result file, an envelope, UTF-8 text)
+    with pytest.raises(InputError, match=rf"^{re.escape(str(p))}: .*\bnot\b"):
         load_result(p)
 
 

@@ -300,6 +300,7 @@ KINDS = ["lqr", "lqg", "lqg_measured", "mpc", "hinf", "user_statespace", "user_g
 
 
 @pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.slow
 def test_margins_against_loop_built_here(kind):
     """The margins at the hinge-moment input of every kind of controller (the built-in LQR,
     LQG, MPC without active constraints and H-infinity, a python-control ``StateSpace`` and a
@@ -677,6 +678,7 @@ def disk(d):
 
 
 @pytest.mark.parametrize("seed", [0, 1, 3, 4])
+@pytest.mark.slow
 def test_simultaneous_disk_margin_two_inputs(seed):
     """The simultaneous disk margin at two plant inputs (``LoopMargins.multiloop``; Seiler,
     Packard & Gahinet 2020: independent ``f_i = (2 + d_i) / (2 - d_i)``, ``|d_i| <= alpha``, in

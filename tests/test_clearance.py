@@ -10,6 +10,7 @@ the same structure and damping).
 import dataclasses
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -229,7 +230,9 @@ def test_parse_altitudes():
     assert parse_altitudes("0,500") == [0.0, 500.0]
     assert parse_altitudes("0:10000:10000", "ft") == pytest.approx([0.0, 3048.0])
     for bad in ("0:1000:0", "a:b:c", "1000:0:100", ""):
-        with pytest.raises(aes.InputError):
+        with pytest.raises(
+            aes.InputError, match=re.escape(f"--altitudes = {bad!r}: expected start:stop:step")
+        ):
             parse_altitudes(bad)
 
 

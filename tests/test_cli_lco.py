@@ -439,6 +439,7 @@ LQR = (
 )
 
 
+@pytest.mark.slow
 def test_closed_loop_smoke(tmp_path, capsys):
     """The shipped LQR scenario, shortened, through 'aeroservo run'."""
     path = tmp_path / "lqr.toml"
@@ -477,6 +478,7 @@ def test_closed_loop_smoke(tmp_path, capsys):
     assert not (tmp_path / "o2").exists()
 
 
+@pytest.mark.slow
 def test_dask_workers_equal_serial(cli_run, section_file):
     """Two local Dask workers give the serial march verdicts, exactly."""
     out, _ = cli_run

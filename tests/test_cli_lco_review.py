@@ -546,7 +546,9 @@ def test_docs_match_the_code(tmp_path):
     # the code's keys: an unknown one lists them
     path = tmp_path / "s.toml"
     path.write_text(SECTION.replace("[lco]", "[lco]\nzzz = 1"))
-    with pytest.raises(InputError) as info:
+    with pytest.raises(
+        InputError, match=r"s\.toml: lco\.zzz = 1: unknown key; allowed keys"
+    ) as info:
         load_scenario(path)
     allowed = re.search(r"allowed keys are (\[.*\])", str(info.value)).group(1)
     assert set(ast.literal_eval(allowed)) == set(lco) | {"hinges"}

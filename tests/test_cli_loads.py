@@ -74,6 +74,7 @@ def test_quick_settings():
     assert (study.v_c, study.v_d) == (100.0, 125.0)
 
 
+@pytest.mark.slow
 def test_loads_command_writes_the_set(cli_run):
     out, text = cli_run
     names = sorted(p.name for p in out.iterdir())
@@ -92,6 +93,7 @@ def test_loads_command_writes_the_set(cli_run):
         assert "wrote " in text and str(out / name) in text
 
 
+@pytest.mark.slow
 def test_files_match_the_python_api(cli_run, api_run):
     out, _ = cli_run
     res = api_run.loads
@@ -120,6 +122,7 @@ def test_files_match_the_python_api(cli_run, api_run):
         np.testing.assert_array_equal(back.arrays[k], v)
 
 
+@pytest.mark.slow
 def test_round_trip_is_equal(api_run, tmp_path):
     res = api_run.loads
     files = write_gust_loads(res, tmp_path / "r.json")
@@ -160,6 +163,7 @@ def test_round_trip_is_equal(api_run, tmp_path):
     np.testing.assert_array_equal(y["root_torque"], y0["root_torque"])
 
 
+@pytest.mark.slow
 def test_damaged_result_files(api_run, tmp_path):
     write_gust_loads(api_run.loads, tmp_path / "r.json")
     with pytest.raises(InputError, match="expected a .json file name"):
@@ -172,6 +176,7 @@ def test_damaged_result_files(api_run, tmp_path):
         load_gust_loads(tmp_path / "other.json")
 
 
+@pytest.mark.slow
 def test_plot_redraws_the_figures(cli_run, capsys):
     out, _ = cli_run
     src = out / f"{STEM}.json"
@@ -370,6 +375,7 @@ wing = "store.toml"
 """
 
 
+@pytest.mark.slow
 def test_open_loop_scenario_with_mass_cases(tmp_path, capsys):
     wing = (ROOT / "scenarios" / "goland_aileron.toml").read_text()
     store = wing.replace(

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pytest
@@ -268,7 +269,7 @@ def test_cubic_hardening_amplitude_follows_required_stiffness():
 def test_bad_input(law, amps, words):
     sec = conner_section()
     el = hinge_elements(sec, [NonlinearHinge("flap", law)])
-    with pytest.raises(InputError) as exc:
+    with pytest.raises(InputError, match=re.escape(words[0])) as exc:
         describing_branches(sec.system(RHO), el, amps)
     text = str(exc.value)
     assert "\n" not in text and all(w in text for w in words), text

@@ -209,6 +209,7 @@ def test_lift_slope_low_aspect_ratio_helmbold():
     assert extrapolated == pytest.approx(helmbold, rel=0.02)
 
 
+@pytest.mark.slow
 def test_lift_slope_high_aspect_ratio_lifting_line():
     """Rectangles of AR 6, 20, 40, 100 (cosine strip spacing, 4-8 chordwise boxes) against
     Prandtl's lifting line by Glauert's series (a0 = 2 pi) coded in ``dlm_reference``.
@@ -409,6 +410,7 @@ def _check_rfa_vs_pk(model, name):
 
 
 @pytest.mark.parametrize("name", ["goland", "goland_aileron", "goland_swept", "goland_store"])
+@pytest.mark.slow
 def test_rfa_flutter_matches_pk(name, request):
     """The time-domain search on the RFA state space vs the p-k on the exact (interpolated) DLM
     forces, rho = 1.225, Mach 0, default settings: within 0.5 %. Measured (RFA / p-k, fit
@@ -567,6 +569,7 @@ def test_pt145_nastran_layout_reproduces_published_dlm():
                 assert result.flutter.frequency == pytest.approx(published[1], rel=0.05)
 
 
+@pytest.mark.slow
 def test_pt145_default_grid():
     """aeroservo's default grid (6 x 17 boxes, 17 modes) and a finer 8 x 24 one give
     161.2 and 162.5 m/s at 130.5 and 128.8 Hz (p-k; RFA within 0.05 %): 5-6 % above the

@@ -73,6 +73,7 @@ def test_root_loads_of_a_steady_gust_are_the_sum_of_the_box_loads(stiff_dlm, spe
     np.testing.assert_allclose(dc, expected, rtol=2e-4)
 
 
+@pytest.mark.slow
 def test_design_model_maps_to_the_plant(aileron_dlm):
     """state_map of a DLM model: a plant state made of the design model's modes only (their
     displacements, rates and Roger lag states) gives the same tip displacement in both."""
@@ -119,6 +120,7 @@ def test_lqr_on_the_dlm_plant_stabilizes_the_sampled_loop(aileron_dlm):
     assert np.abs(tip[-200:]).max() < 0.05 * np.abs(tip[:200]).max()
 
 
+@pytest.mark.slow
 def test_rfa_onsets_are_checked_against_the_tabulated_forces(goland_dlm):
     """Default settings: the time-domain onset is within 0.5 % of the p-k with the tabulated
     GAFs and the check's own estimate agrees with the p-k sweep to 0.1 %."""
@@ -133,6 +135,7 @@ def test_rfa_onsets_are_checked_against_the_tabulated_forces(goland_dlm):
     assert "doublet lattice at Mach 0" in r.summary()
 
 
+@pytest.mark.slow
 def test_a_spurious_rfa_onset_is_flagged(goland_dlm):
     """Six lag roots over k <= 2 couple into instabilities at 0.3-1.3 kHz from 29 m/s that the
     tabulated forces do not have (measured): each is reported as not confirmed, and the

@@ -7,6 +7,7 @@ exit 2, nothing written. Coarse lattices (4 chordwise boxes) and few elements ke
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -110,7 +111,7 @@ def test_wing_file_matched_compressibility_allowed(tmp_path):
 )
 def test_wing_file_bad_aero_keys(tmp_path, extra, fragment):
     path = _wing_file(tmp_path, extra)
-    with pytest.raises(aes.InputError) as err:
+    with pytest.raises(aes.InputError, match=re.escape(fragment)) as err:
         load_wing(path)
     msg = str(err.value)
     assert fragment in msg and "\n" not in msg
@@ -194,7 +195,7 @@ def test_scenario_file_and_command_line_overrides(tmp_path, capsys, panelaero):
 )
 def test_scenario_bad_aero_keys(model, kind, fragment):
     flight = {"flight": {"density": 1.225, "speed": 100.0}}
-    with pytest.raises(aes.InputError) as err:
+    with pytest.raises(aes.InputError, match=re.escape(fragment)) as err:
         scenario_from_dict(_scenario(model, kind, **flight), "s.toml")
     assert fragment in str(err.value) and "\n" not in str(err.value)
 

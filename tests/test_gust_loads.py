@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 import aeroservo as aes
 from aeroservo.aero.atmosphere import isa
@@ -89,7 +90,7 @@ def test_tas_and_f_g_follow_the_rule():
 
 
 def test_a_state_feedback_gain_is_carried_to_another_altitude_in_its_own_basis():
-    sc = load_scenario("scenarios/goland_aileron_lqr.toml")
+    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
     st = _study(
         controller=sc.controller,
         sensors=(),
@@ -197,7 +198,7 @@ def test_a_point_without_any_loop_is_kept_with_its_reasons():
 
 def test_a_state_feedback_object_acts_in_the_design_points_basis():
     """The designed LQR given as an object gives the loads of its spec at another altitude."""
-    sc = load_scenario("scenarios/goland_aileron_lqr.toml")
+    sc = load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml")
     kw = dict(
         sensors=(),
         outputs=("tip_disp",),

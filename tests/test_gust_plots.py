@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 import inspect
+import re
 
 import matplotlib
 import numpy as np
@@ -89,6 +90,7 @@ def _ellipses(ax) -> list:
     return [ln for ln in ax.lines if len(ln.get_xdata()) > 100]
 
 
+@pytest.mark.slow
 def test_every_figure_has_its_panels(result, tmp_path):
     assert result.loops == ["open", "closed"]
     loads = result.loads
@@ -304,7 +306,7 @@ def test_tuning_curves_and_tuned_extremes(result):
     ],
 )
 def test_bad_arguments_are_one_line(result, call, needles):
-    with pytest.raises(InputError) as err:
+    with pytest.raises(InputError, match=re.escape(needles[0])) as err:
         call(result)
     msg = str(err.value)
     assert "\n" not in msg

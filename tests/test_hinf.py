@@ -70,6 +70,7 @@ def weighted_norm(loop, speed, k, spec, dt, omega):
     return np.array(out)
 
 
+@pytest.mark.slow
 def test_synthesis_meets_its_gamma_on_the_full_design_model(setup):
     _model, vf, loop, spec = setup
     speed, dt = 1.1 * vf, 1e-3
@@ -88,6 +89,7 @@ def test_synthesis_meets_its_gamma_on_the_full_design_model(setup):
         assert np.abs(np.linalg.eigvals(A)).max() < 1.0
 
 
+@pytest.mark.slow
 def test_shipped_hinf_scenario_suppresses_flutter_with_margins():
     """Acceptance (issue 24): the shipped H-infinity scenario above the open-loop flutter speed
     is stable, decays, meets 6 dB / 45 deg at the hinge-moment input with the compensator a

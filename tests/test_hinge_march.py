@@ -322,6 +322,7 @@ def lco_table():
     return rows
 
 
+@pytest.mark.slow
 def test_conner_lco_table(lco_table):
     """Between the flap-free (6.49 m/s) and the gap-closed (23.74 m/s) flutter speeds the
     flap neither comes to rest in the gap nor diverges: after 30 s its RMS is steady (1 %
@@ -441,6 +442,7 @@ def critical_stiffness(speed, lo=1.0, hi=1.6):
 
 
 @pytest.mark.parametrize("start", [0.01, 0.08])
+@pytest.mark.slow
 def test_cubic_hardening_lco(start):
     """From below and from above, the flap settles on one cycle whose amplitude the describing
     function ``k + 3/4 c A^2 = k_crit`` predicts (to 2 %: the one-harmonic approximation), and

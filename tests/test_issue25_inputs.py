@@ -61,7 +61,7 @@ def test_plausible_damping_is_not_warned(damping):
 
 def test_semichord_in_millimetres_names_the_chord(tmp_path):
     p = wing_file(tmp_path, body=GOLAND.replace("semichord = 0.9144", "semichord = 914.4"))
-    with pytest.raises(InputError) as exc:
+    with pytest.raises(InputError, match="semichord 914.4 m") as exc:
         load_wing(p)
     msg = str(exc.value)
     assert "inertia" in msg and "semichord 914.4 m" in msg and "millimetres, write 0.9144" in msg

@@ -9,6 +9,7 @@ over a window ``T`` by at most about ``3 eps / T`` (4 used).
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -325,7 +326,7 @@ X = np.sin(2 * np.pi * T)
     ],
 )
 def test_bad_input_is_one_clear_line(args, kwargs, message):
-    with pytest.raises(InputError) as err:
+    with pytest.raises(InputError, match=re.escape(message)) as err:
         classify(*args, **kwargs)
     assert message in str(err.value)
     assert "\n" not in str(err.value)

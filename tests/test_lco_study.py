@@ -58,6 +58,7 @@ def _first_harmonic(row, gap: float) -> float:
     return float(np.hypot(c[1], c[2]))
 
 
+@pytest.mark.slow
 def test_describing_function_agrees_with_the_marches_where_they_settle(study):
     b = study.branches
     seen = b.stable & b.others_stable
@@ -84,6 +85,7 @@ def test_describing_function_agrees_with_the_marches_where_they_settle(study):
         assert abs(f_df / f - 1.0) < 0.01
 
 
+@pytest.mark.slow
 def test_describing_function_predicts_limit_cycles_below_the_marches_onset(study):
     b = study.branches
     seen = b.stable & b.others_stable & (b.frequency > 10.0)

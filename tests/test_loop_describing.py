@@ -57,6 +57,7 @@ def goland():
 
 # 1. A zero command gives the open-loop describing function --------------------------------
 @pytest.mark.parametrize("kind", ["open loop", "zero output feedback", "delayed zero feedback"])
+@pytest.mark.slow
 def test_zero_command_is_the_open_loop_describing_function(goland, kind):
     """Goland LCO window (134-139 m/s): the same points, speeds and frequencies to 1e-8
     (Brent's tolerance 1e-10 on both sides; the rates of ``expm(A dt)`` equal ``Re lambda`` to
@@ -186,6 +187,7 @@ def test_branches_against_marches(goland, v, start, gaps, speeds):
 
 
 # The limit-cycle study uses it --------------------------------------------------------------
+@pytest.mark.slow
 def test_lco_study_gives_the_loop_branches(goland):
     """``run_lco``'s describing function of a setup with a loop and a controller: the sampled
     loop's branches (the buzz at 140-150 m/s among them) instead of a note "open loop only"; a

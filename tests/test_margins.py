@@ -206,6 +206,7 @@ def lqg_loop():
 
 @pytest.mark.parametrize("measured", [False, True], ids=["black_box", "measured_input"])
 @pytest.mark.parametrize("delay", [False, True])
+@pytest.mark.slow
 def test_shipped_lqg_margins_against_eigenvalues(lqg_loop, delay, measured):
     """The 100+-state LQG loop of the shipped scenario above the flutter speed: two unstable
     open-loop poles (the flutter pair), two encirclements, and every margin confirmed by the

@@ -165,6 +165,7 @@ def test_tip_store_against_central_differences():
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.slow
 def test_random_masses_against_central_differences(seed):
     """Random masses (some on the aileron): every mass parameter and the parameters that move
     the aileron's masses."""
@@ -228,6 +229,7 @@ def test_cli_lists_and_plots_mass_sensitivities(tmp_path, capsys):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_masses_on_a_cranked_swept_wing():
     """A crank (sweep 0 then 0.35 rad at 3 m) turns element unknowns into nodal ones; the mass
     derivatives go through the same transform: matrix level against central differences of the

@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -404,7 +405,7 @@ def test_bad_mass_tables(table, fragment, tmp_path, capsys):
     """One line naming the key and the value, from the file reader and from the CLI."""
     path = tmp_path / "w.toml"
     path.write_text(store_file(table))
-    with pytest.raises(InputError) as err:
+    with pytest.raises(InputError, match=re.escape(fragment)) as err:
         load_wing(path)
     assert fragment in str(err.value) and "\n" not in str(err.value)
     assert main(["modes", str(path)]) == 2

@@ -130,6 +130,7 @@ def test_near_critical_in_text_json_and_cli(capsys):
     assert code == 0 and "near-critical" in out and "1st bending" in out
 
 
+@pytest.mark.slow
 def test_time_domain_and_pk_discrepancy_is_one_warning(capsys):
     """Issue 26's flap without GJ: the R.T. Jones time-domain onset (328.68 m/s) and the exact
     C(k) p-k (339.22 m/s) differ by 3.2 %, beyond the 3 % the warning allows."""

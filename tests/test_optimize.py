@@ -11,6 +11,7 @@ boundaries, and the Lagrange condition holds with central differences of the flu
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from conftest import ROOT
@@ -104,7 +105,7 @@ def test_bad_files(tmp_path, old, new, fragment):
     assert old in text
     p = tmp_path / "o.toml"
     p.write_text(text.replace(old, new))
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InputError, match=re.escape(fragment)) as info:
         p2 = load_optimization(p)
         optimize_wing(p2.wing, p2.density, p2.variables, p2.objective, p2.constraints)
     msg = str(info.value)
@@ -120,6 +121,7 @@ def test_bad_arguments(problem):
         optimize_wing(problem.wing, 1.225, problem.variables, {"segments[0].EI": 1.0}, {})
 
 
+@pytest.mark.slow
 def test_codesign_shipped_case(capsys):
     """Aileron chord and LQR Bryson weight for the highest closed-loop flutter speed under a
     600 N m gust hinge-moment limit: a better design than the start, the limit met on a fresh
@@ -168,6 +170,7 @@ def balance():
     }
 
 
+@pytest.mark.slow
 def test_mass_balance_least_balance_bracketed(balance):
     """The least balance (largest S_beta) with V_f >= 126.5 m/s (g = 0.02): the optimum meets
     the constraint on a fresh analysis, and 1e-3 kg m/m less balance breaks it (independent of
@@ -188,6 +191,7 @@ def test_mass_balance_least_balance_bracketed(balance):
     assert vf(s) >= 126.5 * (1 - 1e-6) and vf(s + 1e-3) < 126.5
 
 
+@pytest.mark.slow
 def test_negative_weights_keep_the_direction(balance):
     """A negative weight maximizes its variable, whatever the sign of the start (the
     objective is scaled by its magnitude, not its sign)."""

@@ -29,6 +29,7 @@ def _run_json(capsys, argv: list[str]) -> dict:
 
 
 @pytest.mark.parametrize("case", [TORSION, BALANCE], ids=["torsion", "mass_balance"])
+@pytest.mark.slow
 def test_out_writes_a_wing_that_flutters_at_the_optimum(tmp_path, capsys, case):
     out = tmp_path / "new" / "folder"  # created, parents too
     r = _run_json(capsys, ["optimize", str(case), "--out", str(out), "--json"])

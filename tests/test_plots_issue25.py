@@ -295,6 +295,7 @@ def test_flutter_mode_as_magnitude_and_phase(aileron10, aileron_flutter):
 
 
 @pytest.mark.usefixtures("kernel_name")
+@pytest.mark.slow
 def test_notebook_shows_each_figure_once():
     """In Jupyter (inline backend) a figure is shown once whether it is the cell's value,
     assigned, or the line ends with ';', and it is ``plt.gcf()`` in its cell."""

@@ -66,6 +66,7 @@ def _march_by_hand(loop, ctrl, speed, tip, limit, duration):
     return sizes[start:].max() / sizes[0]
 
 
+@pytest.mark.slow
 def test_study_against_a_loop_marched_by_hand():
     """The H-infinity loop at 1.1 V_f from a 5 cm tip deflection with a 600 N m limit: lost
     with anti-windup, recovered without (the issue's finding), as the hand march says."""

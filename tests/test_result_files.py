@@ -290,6 +290,7 @@ def test_matlab_loader_ships():
         assert field in text
 
 
+@pytest.mark.slow
 def test_modes_command_plot_and_animation(tmp_path, capsys):
     from PIL import Image
 
@@ -336,6 +337,7 @@ def test_envelope_saved_and_redrawn(tmp_path, capsys):
     assert "is a flutter envelope" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_flutter_mode_animation_from_a_saved_sweep(sweep, tmp_path, capsys):
     from PIL import Image
 

@@ -65,6 +65,7 @@ def test_every_shipped_scenario_runs(path, tmp_path, capsys):
             assert summary["verdict"] == "unstable" and summary["expect_failure"]
 
 
+@pytest.mark.slow
 def test_simulation_summary_and_result_roundtrip(tmp_path):
     sc = quick(load_scenario(ROOT / "scenarios" / "goland_aileron_lqr.toml"))
     run = run_simulation(sc)

@@ -45,6 +45,7 @@ def controller(setup, kind: str):
 
 @pytest.mark.parametrize("delay", [False, True], ids=["no_delay", "delay"])
 @pytest.mark.parametrize("kind", ["lqr", "lqg", "mpc", "hinf"])
+@pytest.mark.slow
 def test_loop_matrix_marches_like_the_simulator(setup, kind, delay):
     model, vf, loop = setup
     ctrl = controller(setup, kind)
@@ -77,6 +78,7 @@ def test_boundary_with_delay_finds_a_stable_interval(setup):
     assert any(a < 1.1 * vf < c for a, c in b.stable_intervals)
 
 
+@pytest.mark.slow
 def test_scenario_delay_reaches_the_boundary(tmp_path):
     """A scenario with delay = true analyses the delayed loop (the boundary moves)."""
     from aeroservo.files import load_scenario

@@ -77,7 +77,7 @@ def test_corpus_is_listed():
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_malformed_file(name):
     path = MALFORMED / name
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InputError, match=re.escape(EXPECTED[name][0])) as info:
         _loader(path)(path)
     assert type(info.value) is InputError
     _check_message(info.value, name, *EXPECTED[name])

@@ -12,10 +12,12 @@ derivatives ``p / V dV/dp``.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from test_stability_named import HALE, hale_wing
-from wing_corpus import corpus
+from wing_corpus import CLASSES, case_name, shared_corpus
 
 import aeroservo as aes
 from aeroservo.aero.atmosphere import isa
@@ -104,29 +106,28 @@ def two_surfaces() -> aes.Wing:
     return replace(w0, control_surfaces=(inner, replace(ail, actuators=acts)))
 
 
-def _named():
-    hale = HALE["inputs"]
-    return [
-        ("goland", aes.AeroelasticModel(goland()), 1.225, None),
-        ("goland_aileron", aes.AeroelasticModel(goland_aileron()), 1.225, None),
-        ("two_surfaces", aes.AeroelasticModel(two_surfaces()), 1.225, None),
-        ("hale", aes.AeroelasticModel(hale_wing()), hale["density_kg_m3"], None),
-        ("hale_aileron", aes.AeroelasticModel(hale_wing(True)), hale["density_kg_m3"], None),
-    ]
+NAMED = {
+    "goland": (goland, 1.225),
+    "goland_aileron": (goland_aileron, 1.225),
+    "two_surfaces": (two_surfaces, 1.225),
+    "hale": (hale_wing, HALE["inputs"]["density_kg_m3"]),
+    "hale_aileron": (lambda: hale_wing(True), HALE["inputs"]["density_kg_m3"]),
+}
+"""The named wings and their densities [kg/m^3]."""
+
+CASES = [*NAMED, *(case_name(klass, 0) for klass in CLASSES if klass != "hale")]
+"""The named wings, then the first wing of each corpus class but ``hale`` (all the others have
+a control surface or several segments); names known at collection, wings built on first use."""
 
 
-def _random():
-    """One wing of each corpus class that has a control surface or several segments."""
-    seen, out = set(), []
-    for case in corpus():
-        if case.klass in seen or case.klass in ("hale",):
-            continue
-        seen.add(case.klass)
-        out.append((case.name, case.model, case.density, case.v_max))
-    return out
-
-
-CASES = _named() + _random()
+@functools.cache
+def named_case(name: str) -> tuple[aes.AeroelasticModel, float, float | None]:
+    """``(model, density [kg/m^3], v_max [m/s] or None)`` of a case of ``CASES``."""
+    if name in NAMED:
+        wing, density = NAMED[name]
+        return aes.AeroelasticModel(wing()), density, None
+    (c,) = (c for c in shared_corpus() if c.name == name)
+    return c.model, c.density, c.v_max
 
 
 def _check(got, ref, value, base, what):
@@ -142,8 +143,16 @@ def _check(got, ref, value, base, what):
     )
 
 
-@pytest.mark.parametrize("name,model,density,v_max", CASES, ids=[c[0] for c in CASES])
-def test_against_central_differences(name, model, density, v_max):
+FAST_CASES = ("goland", "goland_aileron", "hale")
+"""The cases ``make test-fast`` runs; the others (the corpus wings: building the corpus takes
+about 20 s) are marked slow."""
+
+
+@pytest.mark.parametrize(
+    "name", [n if n in FAST_CASES else pytest.param(n, marks=pytest.mark.slow) for n in CASES]
+)
+def test_against_central_differences(name):
+    model, density, v_max = named_case(name)
     s = flutter_sensitivities(model, density, rtol=RTOL, v_max=v_max)
     assert s.flutter_speed is not None or s.divergence_speed is not None
     if s.non_differentiable:
@@ -556,10 +565,11 @@ def test_actuator_at_a_surface_end_is_one_sided():
     assert "outboard" not in s.undefined[name]
 
 
+@pytest.mark.slow
 def test_damped_modes_at_rest_on_an_exact_eigenvalue():
     """Rayleigh damping on a corpus wing where the Rayleigh-quotient iteration lands on the
     eigenvalue exactly (a singular solve, found by review): the pair is returned."""
-    case = {c.name: c for c in corpus()}["two_flaps_04"]
+    case = {c.name: c for c in shared_corpus()}["two_flaps_04"]
     a = case.model.wing.segments[0].a
     wing = with_parameters(case.model.wing, {"segments[0].a": a - 1e-5 * abs(a)})
     damping = StructuralDamping.rayleigh(0.200002, 1e-4)

@@ -40,7 +40,7 @@ import pytest
 import scipy.linalg as sla
 from scipy.optimize import brentq, minimize_scalar
 from threadpoolctl import threadpool_limits
-from wing_corpus import CLASSES, Case, case_names, corpus
+from wing_corpus import CLASSES, Case, case_names, shared_corpus
 
 import aeroservo as aes
 from aeroservo.stability import pk_flutter
@@ -52,7 +52,7 @@ IDS = case_names()
 @functools.cache
 def cases() -> list[Case]:
     """The corpus (built once per session)."""
-    built = corpus()
+    built = list(shared_corpus())
     assert [c.name for c in built] == IDS
     return built
 

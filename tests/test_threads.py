@@ -1,5 +1,6 @@
 """BLAS pools are limited inside aeroservo's compute entry points and restored outside."""
 
+import numpy as np
 import pytest
 from threadpoolctl import threadpool_info, threadpool_limits
 
@@ -17,6 +18,7 @@ def test_limited_inside_restored_outside(monkeypatch):
 
     @blas_limited
     def work():
+        np.ones((2, 2)) @ np.ones((2, 2))  # numpy's BLAS is loaded (run alone, nothing else has)
         seen.extend(blas_pools())
 
     with threadpool_limits(limits=2, user_api="blas"):

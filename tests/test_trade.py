@@ -54,6 +54,7 @@ def run(study, cluster, tmp_path_factory):
     return out, result
 
 
+@pytest.mark.slow
 def test_workers_are_single_threaded(cluster):
     from distributed import Client
 
@@ -64,6 +65,7 @@ def test_workers_are_single_threaded(cluster):
         assert w["OMP_NUM_THREADS"] == w["OPENBLAS_NUM_THREADS"] == w["MKL_NUM_THREADS"] == "1"
 
 
+@pytest.mark.slow
 def test_files_written_and_round_trip(run, study):
     out, r = run
     assert r.n_cases == 4 and r.n_skipped == 0
@@ -87,6 +89,7 @@ def test_files_written_and_round_trip(run, study):
     np.testing.assert_array_equal(csv["suppression_margin"], r.table["suppression_margin"])
 
 
+@pytest.mark.slow
 def test_bad_variant_recorded_others_succeed(run):
     out, r = run
     t = r.table
@@ -106,6 +109,7 @@ def test_bad_variant_recorded_others_succeed(run):
     assert rec["status"] == "failed" and "station" in rec["error"]
 
 
+@pytest.mark.slow
 def test_cluster_result_equals_in_process(run, study):
     _, r = run
     row = r.table[(r.table["actuator_station"] == GOOD) & (r.table["bryson_hinge_moment"] == 600)]
@@ -120,6 +124,7 @@ def test_cluster_result_equals_in_process(run, study):
     )
 
 
+@pytest.mark.slow
 def test_rerun_skips_and_resume_runs_only_missing(run, study, cluster):
     out, first = run
     t0 = time.perf_counter()
@@ -140,6 +145,7 @@ def test_rerun_skips_and_resume_runs_only_missing(run, study, cluster):
     )
 
 
+@pytest.mark.slow
 def test_load_and_plots(run, tmp_path):
     out, r = run
     loaded = trade.load_trade(out)
@@ -165,6 +171,7 @@ def test_load_and_plots(run, tmp_path):
         loaded.heatmap(x="speed_factor")
 
 
+@pytest.mark.slow
 def test_default_local_cluster_open_loop(tmp_path):
     st = trade.TradeStudy(
         base_wing=aes.examples.goland_aileron(),

@@ -232,6 +232,7 @@ def folder(tmp_path_factory):
     return out / "trade_aileron"
 
 
+@pytest.mark.slow
 def test_run_writes_one_heatmap_per_metric(folder):
     names = {p.name for p in folder.iterdir()}
     assert names == {
@@ -255,6 +256,7 @@ def test_run_writes_one_heatmap_per_metric(folder):
     }
 
 
+@pytest.mark.slow
 def test_plot_metric_and_slice(folder, tmp_path, capsys):
     png = tmp_path / "h.png"
     argv = ["plot", str(folder), "--metric", "tip_accel_peak", "--out", str(png)]
@@ -275,6 +277,7 @@ def test_plot_metric_and_slice(folder, tmp_path, capsys):
         (["--kind", "pareto", "--metric", "disk_margin"], "apply to the heat map"),
     ],
 )
+@pytest.mark.slow
 def test_plot_errors_are_one_line(folder, tmp_path, capsys, options, fragment):
     assert main(["plot", str(folder), *options, "--out", str(tmp_path / "x.png")]) == 2
     err = capsys.readouterr().err

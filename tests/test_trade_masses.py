@@ -87,6 +87,7 @@ def test_a_closed_loop_or_aileron_study_still_needs_one_surface():
         )
 
 
+@pytest.mark.slow
 def test_scenario_loads_and_runs_quick(tmp_path, capsys):
     """The shipped carpet scenario: an open-loop study of the store's mass and offset; with
     ``--quick`` (2 x 2 cases, one worker) it writes the table and the heatmap."""

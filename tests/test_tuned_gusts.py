@@ -115,6 +115,7 @@ def _profile(t, v, h, u):
     return np.where(s <= 2 * h, 0.5 * u * (1 - np.cos(np.pi * s / h)), 0.0)
 
 
+@pytest.mark.slow
 def test_march_equals_fine_integration():
     """One 1-cos gust on the Goland wing: FOH-exact march vs Radau on the same ODE."""
     v, h, u = 100.0, 20.0, 10.0
@@ -199,6 +200,7 @@ def aileron_model():
     return sys, alt
 
 
+@pytest.mark.slow
 def test_tuned_extreme_at_least_dense_scan(aileron_model):
     sys, alt = aileron_model
     res = tuned_gust_loads(sys, alt, 0.9)
@@ -251,6 +253,7 @@ def _oscillator(speed=100.0, freq=1.0, zeta=0.02):
     return sys
 
 
+@pytest.mark.slow
 def test_tuning_finds_an_interior_optimum():
     """The clamped Goland wing peaks at the ends of the H range; an oscillator of 1 Hz at
     100 m/s is tuned inside it (2 H / V about its period, H about 50 m)."""

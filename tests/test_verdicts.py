@@ -49,6 +49,7 @@ def test_signal_growth():
     assert np.isnan(signal_growth(np.zeros(10)))
 
 
+@pytest.mark.slow
 def test_unstable_design_gets_verdict_results_and_exit_3(tmp_path, capsys):
     """An LQG on 8 design modes with optimistic accelerometer noise and 100 Hz filters is unstable
     on the full plant: verdict "unstable", spectral radius > 1, one line with a hint, results

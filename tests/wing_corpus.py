@@ -18,6 +18,7 @@ the engine with their own fine reference.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -665,6 +666,13 @@ def corpus(seed: int = SEED) -> list[Case]:
     rng = np.random.default_rng(seed)
     with threadpool_limits(1):  # small dense eigenproblems: one BLAS thread is fastest
         return [_case(rng, klass, k) for klass, n in CLASSES.items() for k in range(n)]
+
+
+@functools.cache
+def shared_corpus() -> tuple[Case, ...]:
+    """:func:`corpus` at the default seed, built once per process (about 20 s) on first use:
+    the test modules that use it share it, and none builds it while pytest collects."""
+    return tuple(corpus())
 
 
 # --------------------------------------------------------------------------------------------
