@@ -197,6 +197,39 @@ def gust_case(points: list[tuple], gust_loads: str = "", flight: str = "speed_fa
     return make
 
 
+RAISES = "def command(t, y):\n    if t > 0.05:\n        raise KeyError('boom')\n    return [0.0]\n"
+
+
+def law_study_case(kind: str):
+    """A limit-cycle (``kind = "lco"``, the wing's freeplay under the loop) or gust-loads
+    scenario whose controller is a Python law that raises at t = 0.051 s: the study stops
+    (a failed march of its own would be recorded, a failing law is not)."""
+
+    def make(tmp: Path) -> list[str]:
+        (tmp / "law.py").write_text(RAISES)
+        ctrl = PYTHON.format(file="law.py", extra="budget_s = 0.2\n")
+        if kind == "loads":
+            argv = gust_case([(0.0, 100.0, "V_C")])(tmp)
+            (tmp / "ctrl.toml").write_text(ctrl)
+            return argv
+        (tmp / "wing.toml").write_text((SCENARIOS / "goland_aileron.toml").read_text())
+        text = (SCENARIOS / "goland_aileron_freeplay_lqr.toml").read_text()
+        for old, new in {
+            'file = "goland_aileron.toml"': 'file = "wing.toml"',
+            'spec = "../controllers/lqr.toml"': 'spec = "ctrl.toml"',
+            "speeds = [120.0, 130.0, 137.0, 140.0, 145.0, 150.0, 155.0, 160.0]": "speeds = [130.0]",
+            "duration = 10.0": "duration = 1.0",
+            "history = 2.0": "history = 0.5",
+        }.items():
+            assert old in text, old
+            text = text.replace(old, new)
+        (tmp / "s.toml").write_text(text)
+        (tmp / "ctrl.toml").write_text(ctrl)
+        return ["lco", str(tmp / "s.toml")]
+
+    return make
+
+
 def wing_case(line: str):
     """The flutter command on the shipped Goland wing with ``line`` added to its segment."""
 
@@ -272,6 +305,10 @@ CASES = [
         "def command(t, y):\n    for _ in range(2):\n        try:\n            while True:\n"
         "                t += 0\n        except BaseException:\n            pass\n"
         "    while True:\n        t += 0\n"), 2, ["law.py:command", "budget of 0.2 s"]),
+    ("py_raises_in_lco_study", law_study_case("lco"), 2,
+     ["law.py:command", "t = 0.051 s", "KeyError: 'boom'"]),
+    ("py_raises_in_gust_loads", law_study_case("loads"), 2,
+     ["law.py:command", "t = 0.051 s", "KeyError: 'boom'"]),
     # D. gain files, derived speeds, sections, limit-cycle and gust-loads scenarios
     ("gain_unknown_states", lqr_case({}, controller=(
         'type = "gain"\nsign = -1\n[gain]\ncontrols = ["aileron_hinge_moment"]\n'
@@ -289,7 +326,7 @@ CASES = [
         {"engaged_speed_factors = [0.95, 1.1]": "", "speed_factor = 1.1 ": "speed = 950.0 "}), 2,
      ["s.toml", "flight.speed = 950.0", "flutter_margin"]),
     ("v_max_factor_beyond", lqr_case(
-        {"closed_loop_boundary = true": "closed_loop_boundary = true",
+        {"closed_loop_boundary = true": "closed_loop_boundary = true",  # kept on
          "v_max_factor = 2.0": "v_max_factor = 9.0", "duration = 3.0": "duration = 0.1"}), 2,
      ["s.toml", "analysis.v_max_factor = 9.0"]),
     ("schedule_beyond", lqr_case({}, controller=(CONTROLLERS / "lqr_scheduled.toml").read_text()
@@ -304,7 +341,7 @@ CASES = [
                                     duration="500.0", dt="0.0001"), 2,
      ["s.toml", "lco.duration = 500", "6e+10 steps in all", "1e+09"]),
     ("gust_vd_below_vc_named", gust_case([(0.0, 100.0, "V_C"), (0.0, 90.0, "V_D")], flight=""),
-     2, ["s.toml", "gust_loads.points[1].speed = 90", "V_D must exceed V_C"]),
+     2, ["s.toml", "gust_loads.points[1].speed = 90", "V_D is not below V_C"]),
     ("gust_vd_below_v_c", gust_case([(0.0, 80.0, "V_D")], "v_c = 100.0", flight=""), 2,
      ["s.toml", "gust_loads.points[0].speed = 80", "v_c = 100"]),
     ("gust_vc_above_v_d", gust_case([(0.0, 130.0, "V_C")], "v_d = 125.0", flight=""), 2,
@@ -324,6 +361,7 @@ CASES = [
 def test_hostile_case_is_one_line(tmp_path, make, code, names):
     argv = make(tmp_path)
     before = snapshot(tmp_path)
+    handler = signal.getsignal(signal.SIGALRM)
     out_dir = tmp_path / "out"
     t0 = time.perf_counter()
     rc, out, err = run_cli([*argv, "--out", str(out_dir)] if argv[0] != "flutter" else argv)
@@ -338,6 +376,8 @@ def test_hostile_case_is_one_line(tmp_path, make, code, names):
         assert name in lines[0], (name, lines[0])
     assert not out_dir.exists() or not any(out_dir.iterdir()), list(out_dir.iterdir())
     assert snapshot(tmp_path) == before  # nothing changed, nothing added (no __pycache__)
+    assert signal.getsignal(signal.SIGALRM) is handler  # a law's timer leaves nothing behind
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
 
 
 def test_the_shipped_python_law_runs_within_its_budget(tmp_path):

@@ -2,7 +2,7 @@
 built by :func:`python_law`) and the files they come from (:func:`run_law_file`), each run
 within a wall-clock budget, with what it may do to aeroservo contained.
 
-The rules (``docs/controllers.md``, "Python laws"):
+The rules (``docs/controllers.md``, "Python laws: what they may do"):
 
 * Each call of a law has a **budget** of wall-clock time (:data:`DEFAULT_BUDGET`, 1 s, a
   controller file's ``budget_s``); loading its file has :data:`IMPORT_BUDGET` (60 s,
@@ -10,7 +10,7 @@ The rules (``docs/controllers.md``, "Python laws"):
   macOS) a ``SIGALRM`` timer interrupts the code when the budget runs out (and again at every
   further budget, should the code swallow the first); elsewhere (Windows, a Dask worker's
   thread) the time of each call is measured and a call over the budget fails once it returns.
-  Either way it is an :class:`LawError` (exit code 2): the law, not the computation, is at
+  Either way it is a :class:`LawError` (exit code 2): the law, not the computation, is at
   fault, and the fix is in the input (the law, or its budget).
 * A command must be finite and at most :data:`MAX_COMMAND` (1e12, the bound of a gain file's
   entries and of every limit) in magnitude: beyond it no actuator is meant.

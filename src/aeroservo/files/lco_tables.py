@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import RANGES, InputError
 from ..simulate.hinges.march import MAX_HINGE_SAMPLES
 from ..studies.lco.study import study_steps
 from ..studies.scenario import Scenario
@@ -56,6 +56,13 @@ SECTION_RANGES = {
 one: ``aeroservo.errors.RANGES``): a value beyond it is a unit error. The typical section
 checks what depends on other keys (``x_alpha`` within the chord, the hinge aft of the
 elastic axis, a positive-definite mass matrix)."""
+
+_UNITS = {
+    k: r.get("unit") or RANGES[r["quantity"]].unit
+    for k, r in SECTION_RANGES.items()
+    if r.get("unit") or "quantity" in r
+}
+"""The unit of each dimensional ``[section]`` key."""
 MAX_SPEEDS = 1000
 """Most speeds of one study."""
 

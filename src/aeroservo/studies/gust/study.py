@@ -84,24 +84,25 @@ class FlightPoint:
 
 
 def speed_order(points, v_c: float | None, v_d: float | None) -> tuple[int, str] | None:
-    """The first flight point whose named speed is out of order, as ``(index, why)``: V_D must
-    exceed V_C, so a point named ``V_D`` must fly faster than ``v_c`` and than every point
+    """The first flight point whose named speed is out of order, as ``(index, why)``: V_D is
+    not below V_C, so a point named ``V_D`` must not fly slower than ``v_c`` nor than a point
     named ``V_C`` at its altitude (V_C and V_D may change with altitude, e.g. above a Mach
-    limit), and a point named ``V_C`` slower than ``v_d``. None when all are in order."""
+    limit; the same speed is allowed, to compare the rule's gusts there), and a point named
+    ``V_C`` not faster than ``v_d``. None when all are in order."""
     vc_at: dict = {}
     for p in points:
         if p.speed_name == "V_C":
             vc_at[p.altitude] = max(vc_at.get(p.altitude, 0.0), p.speed)
     for i, p in enumerate(points):
-        if p.speed_name == "V_D" and v_c is not None and not p.speed > v_c:
-            return i, f"the point is named V_D, but v_c = {v_c:g} m/s EAS (V_D must exceed V_C)"
-        if p.speed_name == "V_D" and not p.speed > vc_at.get(p.altitude, 0.0):
+        if p.speed_name == "V_D" and v_c is not None and p.speed < v_c:
+            return i, f"the point is named V_D, but v_c = {v_c:g} m/s EAS (V_D is not below V_C)"
+        if p.speed_name == "V_D" and p.speed < vc_at.get(p.altitude, 0.0):
             return i, (
                 f"the point is named V_D, but a point named V_C at the same altitude "
-                f"({p.altitude:g} m) flies at {vc_at[p.altitude]:g} m/s EAS (V_D must exceed V_C)"
+                f"({p.altitude:g} m) flies at {vc_at[p.altitude]:g} m/s EAS (V_D is not below V_C)"
             )
-        if p.speed_name == "V_C" and v_d is not None and not p.speed < v_d:
-            return i, f"the point is named V_C, but v_d = {v_d:g} m/s EAS (V_C must be below V_D)"
+        if p.speed_name == "V_C" and v_d is not None and p.speed > v_d:
+            return i, f"the point is named V_C, but v_d = {v_d:g} m/s EAS (V_C is not above V_D)"
     return None
 
 
