@@ -23,6 +23,7 @@ __all__ = [
     "VerdictFailure",
     "check_number",
     "check_int",
+    "check_derived_speed",
     "parse_number",
     "show_value",
 ]
@@ -247,3 +248,33 @@ def check_quantity(field: str, value: object, quantity: str) -> float:
     return check_number(
         field, value, unit=r.unit, lo=r.lo, hi=r.hi, lo_open=r.lo_open, hi_open=r.hi_open
     )
+
+
+def check_derived_speed(field: str, value: object, speed: float, how: str) -> float:
+    """A speed [m/s] derived from a user's key (a multiple of the open-loop flutter speed, a
+    margin on a speed), refused beyond the airspeed range of :data:`RANGES` with the key that
+    produced it.
+
+    Parameters
+    ----------
+    field
+        The key, with its file: ``"scenario.toml: flight.speed_factor"``.
+    value
+        The key's value.
+    speed
+        The speed it gives [m/s].
+    how
+        How it gives it, e.g. ``"x the open-loop flutter speed 137.4 m/s"``.
+
+    Raises
+    ------
+    InputError
+        ``"<field> = <value>: gives <speed> m/s (<how>), beyond the airspeed range ..."``.
+    """
+    r = RANGES["airspeed"]
+    if not r.lo <= speed <= r.hi:
+        raise InputError(
+            f"{field} = {show_value(value)}: gives {speed:.6g} m/s ({how}), beyond the airspeed "
+            f"range {r.text()}"
+        )
+    return speed

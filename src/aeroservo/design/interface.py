@@ -24,7 +24,7 @@ refuse a controller without one, never treating it as an open loop.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +34,7 @@ from ..linear.signals import check_names, describe
 from .compensator import check_period, compensator_from_lti, sample_period
 from .law import LinearLaw, state_gain
 from .protocol import Controller, ScheduledController
+from .user_code import PythonLaw, python_law
 
 __all__ = [
     "as_controller",
@@ -288,91 +289,3 @@ def static_gain(
     if states is not None:
         return StaticGain(G, controls, (), cols, dt, sign)
     return StaticGain(G, controls, cols, (), dt, sign)
-
-
-@dataclass
-class PythonLaw:
-    """A nonlinear or adaptive law written in Python (simulated; no linear analyses).
-
-    ``fn(t, y)`` (or ``fn(t, y, x)`` with ``needs_state``) returns the commands at time ``t``
-    [s] from the sensor values ``y`` (and the plant state ``x``); ``reset()`` (optional) is
-    called before each run. Built, it is at ``t = 0``: ``command`` works before ``reset``.
-    Use :func:`python_law` to build one.
-    """
-
-    fn: Callable
-    controls: tuple
-    sensors: tuple
-    dt: float
-    needs_state: bool = False
-    on_reset: Callable | None = None
-    name: str = "Python law"
-    is_linear: bool = False
-    _k: int = field(default=0, init=False, repr=False, compare=False)
-
-    def reset(self) -> None:
-        self._k = 0
-        if self.on_reset is not None:
-            self.on_reset()
-
-    def command(self, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
-        t = self._k * self.dt
-        try:
-            out = self.fn(t, y, x) if self.needs_state else self.fn(t, y)
-        except Exception as exc:  # the user's code: reported as an input error, with its place
-            raise InputError(
-                f"{self.name}: raised {type(exc).__name__} at t = {t:g} s: {exc}"
-            ) from exc
-        try:
-            c = np.asarray(out, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            c = np.array([np.nan])
-        if c.size != len(self.controls) or not np.all(np.isfinite(c)):
-            raise InputError(
-                f"{self.name}: returned {describe(out)} at t = {t:g} s; expected "
-                f"{len(self.controls)} finite commands {list(self.controls)}"
-            )
-        return c
-
-    def update(self, y: np.ndarray, u: np.ndarray) -> None:
-        self._k += 1
-
-
-def python_law(
-    fn: Callable,
-    controls: Sequence[str],
-    sensors: Sequence[str] = (),
-    *,
-    sample_rate: float,
-    needs_state: bool = False,
-    reset: Callable | None = None,
-    name: str | None = None,
-) -> PythonLaw:
-    """A controller from a Python function ``fn(t, y) -> commands`` (see :class:`PythonLaw`).
-
-    Parameters
-    ----------
-    fn : callable
-        ``fn(t [s], y)`` or, with ``needs_state``, ``fn(t, y, x)``; returns one command per
-        control, in the controls' units.
-    controls, sensors : sequence of str
-    sample_rate : float
-        [Hz]
-    needs_state : bool
-        Pass the plant state too.
-    reset : callable, optional
-        Called before each simulation (to clear the law's own memory).
-    """
-    if not callable(fn):
-        raise InputError(f"fn = {describe(fn)}: expected a function fn(t, y)")
-    if reset is not None and not callable(reset):
-        raise InputError(f"reset = {describe(reset)}: expected a function of no argument")
-    return PythonLaw(
-        fn,
-        tuple(check_names("controls", controls)),
-        tuple(check_names("sensors", sensors, empty=True)),
-        sample_period(sample_rate),
-        bool(needs_state),
-        reset,
-        name or getattr(fn, "__name__", "Python law"),
-    )

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import InputError, check_int, check_number
+from ..errors import InputError, check_derived_speed, check_int, check_number, show_value
 from ..linear.models import tip_deflection_state
 from ..linear.state_space import StateSpaceBuilder
 from ..linear.tags import carry_tags
@@ -34,6 +34,7 @@ from .output_feedback import lqg
 from .plant import OpenLoop, SampledPlant, filter_arrays, state_map, with_sensor_filters
 from .spec import ControllerSpec, check_spec_signals
 from .state_feedback import Bryson, lqr_controller
+from .user_code import DEFAULT_BUDGET
 
 SAMPLED_CACHE = 96
 """Sampled plants kept per :class:`ControlLoop` (about 80 kB each for a 10-element wing)."""
@@ -276,7 +277,15 @@ class ControlLoop:
                 if spec.type == "gain" and (spec.gain or {}).get("states"):
                     from .sampled_loop import plant_states
 
-                    ctrl.law(plant_states(self.plant(speed)))  # its states must be the plant's
+                    states = plant_states(self.plant(speed))  # its states must be the plant's
+                    missing = [s for s in spec.gain["states"] if s not in states]
+                    if missing:
+                        raise InputError(
+                            f"gain.states = {show_value(spec.gain['states'])}: "
+                            f"{show_value(missing[:5])} are not states of the plant "
+                            f"({len(states)} states, e.g. {states[:4]})"
+                        )
+                    ctrl.law(states)
                 return ctrl
             except InputError as exc:
                 raise InputError(f"{spec.source}: {exc}") from None
@@ -334,7 +343,16 @@ class ControlLoop:
             return one(speed)
         if flutter_speed is None:
             raise InputError(f"{spec.source}: schedule needs the open-loop flutter speed")
-        ctrl: GainSchedule = schedule(one, [f * flutter_speed for f in spec.schedule])
+        speeds = [
+            check_derived_speed(
+                f"{spec.source}: schedule.speed_factors",
+                list(spec.schedule),
+                f * flutter_speed,
+                f"{f:g} x the open-loop flutter speed {flutter_speed:.6g} m/s",
+            )  # fmt: skip
+            for f in spec.schedule
+        ]
+        ctrl: GainSchedule = schedule(one, speeds)
         ctrl.design_speed = speed
         return ctrl
 
@@ -377,4 +395,5 @@ def brought_controller(spec: ControllerSpec, controls, sensors, rate: float):
         sample_rate=rate,
         needs_state=p.get("needs_state", False),
         name=p.get("source", "Python law"),
+        budget=p.get("budget", DEFAULT_BUDGET),
     )

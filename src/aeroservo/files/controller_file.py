@@ -38,6 +38,8 @@ TOP_KEYS = (
     "anti_windup",
     "function",
     "needs_state",
+    "budget_s",
+    "import_budget_s",
     "sensors",
     "gain",
     "weights",
@@ -95,7 +97,15 @@ def _controller_from_dict(data: object, file: str) -> ControllerSpec:
         "hinf": ("weights", "limits", "hinf", "margins", "anti_windup"),
         "linear": ("file", "method", "prewarp", "sign", "anti_windup", "limits", "margins"),
         "gain": ("gain", "sign", "limits", "margins"),
-        "python": ("file", "function", "sensors", "needs_state", "limits"),
+        "python": (
+            "file",
+            "function",
+            "sensors",
+            "needs_state",
+            "budget_s",
+            "import_budget_s",
+            "limits",
+        ),  # fmt: skip
     }[kind]
     for key in TOP_KEYS[3:]:
         if top.has(key) and key not in allowed:
@@ -230,12 +240,23 @@ def brought(top: Table, kind: str, kw: dict, base: Path) -> None:
         return
     path = top.path("file", base, required=True)
     if kind == "python":
+        from ..design.user_code import DEFAULT_BUDGET, IMPORT_BUDGET, MAX_BUDGET
+
+        seconds = {"unit": "s", "lo": 0.0, "lo_open": True, "hi": MAX_BUDGET}
+        budget = top.number("budget_s", DEFAULT_BUDGET, **seconds)
         kw["python"] = {
-            "function": python_function(top, path, top.string("function", required=True)),
+            "function": python_function(
+                top,
+                path,
+                top.string("function", required=True),
+                top.number("import_budget_s", IMPORT_BUDGET, **seconds),
+            ),  # fmt: skip
             "sensors": top.strings("sensors") if top.has("sensors") else None,
             "needs_state": top.boolean("needs_state", False),
             "source": f"{path.name}:{top.data['function']}",
         }
+        if top.has("budget_s"):  # only then: the ids of trade cases stay as they were
+            kw["python"]["budget"] = budget
         return
     from ..design.compensator import DISCRETIZATIONS
     from .linear_controller import read_linear_controller
@@ -267,19 +288,24 @@ def _sign(top: Table) -> int:
     return sign
 
 
-def python_function(top: Table, path: Path, name: str):
+def python_function(top: Table, path: Path, name: str, budget: float):
     """The function ``name`` of the Python file ``path`` (run as a module, as the user's own
-    code); errors name the controller file's key."""
-    import importlib.util
+    code, within ``budget`` [s]: :func:`~aeroservo.design.user_code.run_law_file`); errors
+    name the controller file's key, what the file wrote while loaded is one warning."""
+    import warnings
 
+    from ..design.user_code import run_law_file
+
+    if path.suffix != ".py":
+        top.fail("file", top.data["file"], "expected a Python file ending in .py")
     if not path.is_file():
         top.fail("file", top.data["file"], f"no such Python file ({path})")
     try:
-        spec = importlib.util.spec_from_file_location(f"aeroservo_law_{path.stem}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    except Exception as exc:  # the user's code: any error is an input error here
-        top.fail("file", top.data["file"], f"running it failed: {type(exc).__name__}: {exc}")
+        module, output = run_law_file(path, budget)
+    except InputError as exc:
+        top.fail("file", top.data["file"], str(exc))
+    if output:
+        warnings.warn(f"{path.name}: not shown: {output} while loaded", stacklevel=2)
     fn = getattr(module, name, None)
     if not callable(fn):
         top.fail("function", name, f"{path.name} defines no function of that name")

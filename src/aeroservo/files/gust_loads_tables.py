@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..aero.gust_rules import U_REF_TABLE, Z_REF
 from ..errors import InputError
-from ..studies.gust.study import SPEED_NAMES, FlightPoint
+from ..studies.gust.study import SPEED_NAMES, FlightPoint, speed_order
 from ..studies.scenario import Scenario
 from ..studies.study_options import GustLoadsOptions
 from .scenario_tables import controller, is_file
@@ -192,6 +192,11 @@ def _points(gl: Table, cases: dict, v_c=None, v_d=None) -> tuple:
         if case not in cases:
             pt.fail("mass_case", case, f"not a mass case; they are {list(cases)}")
         points.append(FlightPoint(altitude, speed, speed_name, case))
+    bad = speed_order(points, v_c, v_d)
+    if bad is not None:
+        i, why = bad
+        pt = Table(items[i], f"{gl.key_name('points')}[{i}]", gl.file)
+        pt.fail("speed", points[i].speed, why)
     return tuple(points)
 
 

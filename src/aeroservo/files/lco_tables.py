@@ -11,8 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import RANGES, InputError
 from ..simulate.hinges.march import MAX_HINGE_SAMPLES
+from ..studies.lco.study import study_steps
 from ..studies.scenario import Scenario
 from ..studies.study_options import LCOOptions
 from .hinge_tables import check_targets, hinges_from_list
@@ -37,16 +38,31 @@ SECTION_KEYS = (
 """Keys of a ``[section]`` table of :class:`~aeroservo.system.section.TypicalSection`
 parameters (all required but ``flap_static_moment``, default 0)."""
 
-_UNITS = {
-    "semichord": "m",
-    "mass": "kg/m",
-    "inertia": "kg m",
-    "k_plunge": "N/m per m",
-    "k_pitch": "N m/rad per m",
-    "flap_static_moment": "kg m/m",
-    "flap_inertia": "kg m",
-    "k_flap": "N m/rad per m",
+_SPRING = {"lo": 0.0, "lo_open": True, "hi": 1e12}
+SECTION_RANGES = {
+    "semichord": {"quantity": "semichord"},
+    "a": {"lo": -1.0, "hi": 1.0},
+    "mass": {"quantity": "mass_per_length"},
+    "x_alpha": {"lo": -2.0, "hi": 2.0},
+    "inertia": {"quantity": "inertia_per_length"},
+    "k_plunge": {"unit": "N/m per m", **_SPRING},
+    "k_pitch": {"unit": "N m/rad per m", **_SPRING},
+    "hinge": {"lo": -1.0, "hi": 1.0, "hi_open": True},
+    "flap_static_moment": {"quantity": "static_moment"},
+    "flap_inertia": {"quantity": "inertia_per_length"},
+    "k_flap": {"quantity": "hinge_stiffness"},
 }
+"""The physical range of each ``[section]`` key (per unit span; the wing file's where it has
+one: ``aeroservo.errors.RANGES``): a value beyond it is a unit error. The typical section
+checks what depends on other keys (``x_alpha`` within the chord, the hinge aft of the
+elastic axis, a positive-definite mass matrix)."""
+
+_UNITS = {
+    k: r.get("unit") or RANGES[r["quantity"]].unit
+    for k, r in SECTION_RANGES.items()
+    if r.get("unit") or "quantity" in r
+}
+"""The unit of each dimensional ``[section]`` key."""
 MAX_SPEEDS = 1000
 """Most speeds of one study."""
 
@@ -107,7 +123,7 @@ def section_table(top: Table, kw: dict) -> None:
             kw["wing_source"] = "builtin section conner" + (" (damped)" if damped else "")
             return
         st.check_keys(tuple(k for k in SECTION_KEYS if k != "flap_static_moment"), SECTION_KEYS)
-        vals = {k: st.number(k, unit=_UNITS.get(k, "")) for k in SECTION_KEYS if st.has(k)}
+        vals = {k: st.number(k, **SECTION_RANGES[k]) for k in SECTION_KEYS if st.has(k)}
         if vals["k_flap"] == 0.0:  # the nonlinear law scales this spring
             st.fail(
                 "k_flap", 0.0, "the nonlinear hinge law acts on this spring (its k): give it > 0"
@@ -196,6 +212,11 @@ def lco_table(lt: Table, kw: dict, closed: bool) -> dict:
         )
     out["settle"] = lt.number("settle", 0.5, lo=0.0, hi=0.9)
     out["continuation"] = lt.boolean("continuation", True)
+    try:
+        n_v, n_a = len(out["speeds"]), len(out["amplitudes"])
+        study_steps(n_v, n_a, out["continuation"], out["duration"], step)
+    except InputError as exc:
+        lt.fail("duration", out["duration"], str(exc))
     out["history"] = lt.number(
         "history", min(2.0, out["duration"]), unit="s", lo=0.0, hi=out["duration"]
     )

@@ -20,6 +20,7 @@ from ..design.law import delayed
 from ..design.plant import Limits, SampledPlant
 from ..design.protocol import steps_its_law
 from ..design.sampled_loop import linear_law, plant_states
+from ..design.user_code import law_session
 from ..errors import RANGES, InputError, check_int, check_number
 from ..linear.models import SAMPLE_RATES, check_continuous
 from ..linear.signals import check_names, describe
@@ -175,24 +176,13 @@ def simulate(
         sd = np.array([sensor_noise.get(s, 0.0) for s in sensors])
         noise = rng.standard_normal((n_steps + 1, len(sensors))) * sd
 
-    controller.reset()
     t0 = time.perf_counter()
-    Y, X, U, Cmd, status = march_loop(
-        sp,
-        controller,
-        law,
-        x,
-        d,
-        noise,
-        s_idx,
-        rec_idx,
-        mag,
-        rate * dt,
-        delay,
-        n_steps,
-        record_states,
-        act,
-    )
+    with law_session(controller):  # a Python law's budget (design/user_code)
+        controller.reset()
+        Y, X, U, Cmd, status = march_loop(
+            sp, controller, law, x, d, noise, s_idx, rec_idx, mag, rate * dt, delay, n_steps,
+            record_states, act,
+        )  # fmt: skip
     wall = time.perf_counter() - t0
     units = dict(getattr(plant, "signal_units", {}))
     recorded = {out_names[i]: Y[:, j] for j, i in enumerate(rec_idx)}

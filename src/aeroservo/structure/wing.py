@@ -12,6 +12,7 @@ field, the value and the allowed range.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -314,7 +315,8 @@ def check_sweep(field: str, value: object, *, degrees: bool = False) -> float:
     v = check_number(field, value, unit="deg" if degrees else "rad")
     rad = float(np.deg2rad(v)) if degrees else v
     if abs(rad) > MAX_SWEEP + 5e-5:  # 1.0472 (60 deg to 4 decimals) is accepted, then clipped
-        shown = f"{v:g} deg" if degrees else f"{v:g} rad ({np.rad2deg(v):.4g} deg)"
+        in_deg = f" ({math.degrees(v):.4g} deg)" if abs(v) < 1e6 else ""  # no overflow
+        shown = f"{v:g} deg" if degrees else f"{v:g} rad{in_deg}"
         allowed = "[-60, 60] deg" if degrees else "[-1.0472, 1.0472] rad (+-60 deg)"
         raise InputError(
             f"{field} = {shown}: allowed range is {allowed}: the strip theory takes the flow "

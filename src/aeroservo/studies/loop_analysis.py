@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import check_derived_speed
 from .scenario import Scenario
 from .verdict import GROWS, signal_growth
 
@@ -163,6 +164,11 @@ def analyse_loop(
     )
     if scenario.closed_loop_boundary:
         v_top = max(scenario.v_max_factor * (flutter_speed or speed), engaged.stable_to)
+        base = "open-loop flutter" if flutter_speed else "design"
+        check_derived_speed(
+            f"{scenario.source}: analysis.v_max_factor", scenario.v_max_factor, v_top,
+            f"the closed-loop sweep's top, x the {base} speed {flutter_speed or speed:.6g} m/s",
+        )  # fmt: skip
         update, close = bar(v_top, "closed-loop sweep")
         try:
             res.boundary = closed_loop_boundary(

@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import NumericalError
+from ..errors import NumericalError, check_derived_speed
 from .kinds import Run, check_kind, run_scenario
 from .loop_analysis import analyse_loop
 from .scenario import Scenario
@@ -99,7 +99,11 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
             f"wing has no flutter below {fr.v_max:.4g} m/s"
         )
     else:
-        speed = scenario.speed_factor * vf
+        speed = check_derived_speed(
+            f"{scenario.source}: flight.speed_factor", scenario.speed_factor,
+            scenario.speed_factor * vf,
+            f"{scenario.speed_factor:g} x the open-loop flutter speed {vf:.6g} m/s",
+        )  # fmt: skip
     loop = scenario.loop(model)
     spec = scenario.controller
     from ..design.interface import controller_at

@@ -144,7 +144,22 @@ class Scenario:
         to ``controller.flutter_margin`` x its top."""
         from dataclasses import replace
 
-        return replace(self._engaged(flutter_speed, speed), flutter_margin=self.flutter_margin)
+        from ..errors import check_derived_speed
+
+        r = replace(self._engaged(flutter_speed, speed), flutter_margin=self.flutter_margin)
+        key, value = "flight.speed", self.speed  # the default range ends at the design speed
+        if self.speed is None:
+            key, value = "flight.speed_factor", self.speed_factor
+        if self.engaged_speeds is not None:
+            key, value = "controller.engaged_speeds", list(self.engaged_speeds)
+        elif self.engaged_speed_factors is not None:
+            key, value = "controller.engaged_speed_factors", list(self.engaged_speed_factors)
+        check_derived_speed(
+            f"{self.source}: {key}", value, r.stable_to,
+            f"up to {r.high:.6g} m/s x controller.flutter_margin = {r.flutter_margin:g}: where "
+            "stability is required",
+        )  # fmt: skip
+        return r
 
     def _engaged(self, flutter_speed: float | None, speed: float):
         from ..design.judgement import EngagedRange

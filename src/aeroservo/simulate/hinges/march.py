@@ -27,6 +27,7 @@ from ...design.law import delayed
 from ...design.plant import Limits
 from ...design.protocol import steps_its_law
 from ...design.sampled_loop import linear_law, plant_states
+from ...design.user_code import law_session
 from ...errors import InputError, check_number
 from ...linear.signals import describe
 from ..result import SimulationResult
@@ -154,13 +155,14 @@ def march_hinges(
         method = "exact between switches (located by Brent's method)"
         march = _march_piecewise
     mag, rate = limits.arrays(controls)
-    if controller is not None:
-        controller.reset()
     t0 = time.perf_counter()
-    X, U, Cmd, switches = march(
-        nplant, Bu, C[isn], D[np.ix_(isn, iu)], nplant.d_n[isn], dt, x, n_steps,
-        controller, law, mag, rate * dt, delay,
-    )  # fmt: skip
+    with law_session(controller):  # a Python law's budget (design/user_code)
+        if controller is not None:
+            controller.reset()
+        X, U, Cmd, switches = march(
+            nplant, Bu, C[isn], D[np.ix_(isn, iu)], nplant.d_n[isn], dt, x, n_steps,
+            controller, law, mag, rate * dt, delay,
+        )  # fmt: skip
     wall = time.perf_counter() - t0
     S = X @ nplant.c_n.T
     phi = nplant.elements.correction(S.T).T

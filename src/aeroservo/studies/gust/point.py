@@ -10,7 +10,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...aero.gust_rules import GRADIENT_RANGE, design_gust_velocity, gust_tas
-from ...errors import InputError
+from ...design.user_code import LawError
+from ...errors import InputError, check_derived_speed
 from ...linear.tags import carry_tags
 from .one_g import one_g_loads
 from .rigid_wing import rigid_gust_loads
@@ -89,7 +90,11 @@ def design_point(study: GustLoadsStudy):
                     "gust loads: the controller's design speed is a multiple of the open-loop "
                     "flutter speed, but the design mass case has no flutter in the searched range"
                 )
-            speed = study.design_speed_factor * vf
+            f = study.design_speed_factor
+            speed = check_derived_speed(
+                f"{study.source or 'gust loads'}: flight.speed_factor", f, f * vf,
+                f"{f:g} x the open-loop flutter speed {vf:.6g} m/s of the design mass case",
+            )  # fmt: skip
         ctrl = loop.design_controller(ctrl, speed, study.sample_rate, vf)
         needs = getattr(ctrl, "needs_state", False) or hasattr(ctrl, "state_map")
         scaling = loop.plant_builder.state_scaling if needs else None
@@ -219,6 +224,8 @@ def evaluate_point(study: GustLoadsStudy, point: FlightPoint) -> PointLoads:
                 res.discrete[name] = tuned_gust_loads(
                     sys, point.altitude, f_g, limits=limits, **kw, **common
                 )
+            except LawError:  # a Python law that fails: the study stops
+                raise
             except InputError as exc:
                 res.notes.append(f"closed loop: {exc}")
                 continue

@@ -56,6 +56,7 @@ def gust_study(scenario: Scenario):
         design_density=scenario.density,
         design_speed=scenario.speed,
         design_speed_factor=scenario.speed_factor,
+        source=scenario.source,
         f_g=g.f_g,
         weights=dict(g.weights),
         elements=scenario.elements,

@@ -83,6 +83,29 @@ class FlightPoint:
         return f"{case}{self.altitude:g} m{name} {self.speed:g} m/s EAS"
 
 
+def speed_order(points, v_c: float | None, v_d: float | None) -> tuple[int, str] | None:
+    """The first flight point whose named speed is out of order, as ``(index, why)``: V_D is
+    not below V_C, so a point named ``V_D`` must not fly slower than ``v_c`` nor than a point
+    named ``V_C`` at its altitude (V_C and V_D may change with altitude, e.g. above a Mach
+    limit; the same speed is allowed, to compare the rule's gusts there), and a point named
+    ``V_C`` not faster than ``v_d``. None when all are in order."""
+    vc_at: dict = {}
+    for p in points:
+        if p.speed_name == "V_C":
+            vc_at[p.altitude] = max(vc_at.get(p.altitude, 0.0), p.speed)
+    for i, p in enumerate(points):
+        if p.speed_name == "V_D" and v_c is not None and p.speed < v_c:
+            return i, f"the point is named V_D, but v_c = {v_c:g} m/s EAS (V_D is not below V_C)"
+        if p.speed_name == "V_D" and p.speed < vc_at.get(p.altitude, 0.0):
+            return i, (
+                f"the point is named V_D, but a point named V_C at the same altitude "
+                f"({p.altitude:g} m) flies at {vc_at[p.altitude]:g} m/s EAS (V_D is not below V_C)"
+            )
+        if p.speed_name == "V_C" and v_d is not None and p.speed > v_d:
+            return i, f"the point is named V_C, but v_d = {v_d:g} m/s EAS (V_C is not above V_D)"
+    return None
+
+
 @dataclass(frozen=True)
 class GustLoadsStudy:
     """What a gust-loads study computes (SI units). See the module docstring.
@@ -128,6 +151,8 @@ class GustLoadsStudy:
         (:mod:`~aeroservo.studies.gust.one_g`), and total limit loads 1 g +- increment.
     lift_share : float
         Share of the airplane's weight the wing carries in 1 g flight (0.5: one of two wings).
+    source : str
+        The scenario file it comes from, named in messages (empty: none).
     v_c, v_d : float or None
         Design cruising and dive speeds [m/s EAS]. With both, a flight point named ``""``
         between them gets U_sigma interpolated linearly between its V_C and V_D values
@@ -168,6 +193,7 @@ class GustLoadsStudy:
     v_d: float | None = None
     aircraft_mass: dict = field(default_factory=dict)
     lift_share: float = 0.5
+    source: str = ""
 
     def __post_init__(self) -> None:
         from ...aero.dlm_settings import as_aero
@@ -237,6 +263,10 @@ class GustLoadsStudy:
                     f"flight point {p.label}: speed = {p.speed:g} m/s EAS is beyond v_d = "
                     f"{vd:g} m/s EAS (the design envelope ends at V_D)"
                 )
+        bad = speed_order(self.points, vc, vd)
+        if bad is not None:
+            p = self.points[bad[0]]
+            raise InputError(f"flight point {p.label}: speed = {p.speed:g} m/s EAS: {bad[1]}")
 
     def one_g_lift(self, mass_case: str) -> float | None:
         """The lift [N] the wing carries in 1 g flight in a mass case (None: not given)."""

@@ -54,6 +54,7 @@ def run_lco(
     if not isinstance(sweep, LCOSweep):
         raise InputError(f"sweep = {sweep!r}: expected an LCOSweep")
     workers = check_int("workers", workers, lo=0, hi=256)
+    sweep.steps(sweep.dt if setup.controller is None else float(setup.controller.dt))
     t0 = time.perf_counter()
     tasks = sweep.tasks()
     marches = sum(len(t[1]) for t in tasks)

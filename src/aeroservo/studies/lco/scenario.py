@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ...errors import NumericalError
+from ...errors import NumericalError, check_derived_speed
 from ..kinds import Run, check_kind
 from ..scenario import Scenario
 
@@ -58,7 +58,11 @@ def lco_setup(scenario: Scenario):
                     f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, "
                     "but the wing has no flutter in the searched range"
                 )
-            speed = scenario.speed_factor * vf
+            speed = check_derived_speed(
+                f"{scenario.source}: flight.speed_factor", scenario.speed_factor,
+                scenario.speed_factor * vf,
+                f"{scenario.speed_factor:g} x the open-loop flutter speed {vf:.6g} m/s",
+            )  # fmt: skip
         loop = scenario.loop(model)
         ctrl = controller_at(loop.design_controller(spec, speed, scenario.sample_rate, vf), speed)
         limits = spec.limits

@@ -20,13 +20,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...design.plant import Limits
+from ...design.user_code import LawError
 from ...errors import InputError, check_number
 from ...simulate.hinges.march import march_hinges
 from ...simulate.hinges.smooth_laws import DivergedMarch
 from ...simulate.lco_detect import classify
 from ...system.hinge_elements import NonlinearHinge, hinge_elements
 
-__all__ = ["LCOSetup", "LCOSweep", "march_task", "HISTORY_SAMPLES"]
+__all__ = [
+    "LCOSetup", "LCOSweep", "march_task", "study_steps", "HISTORY_SAMPLES", "MAX_STUDY_STEPS",
+]  # fmt: skip
 
 DIVERGED = 10.0
 """A growing march is called divergent once its reference rotation exceeds this many gaps
@@ -102,6 +105,36 @@ class LCOSetup:
         return section_plant(self.model, self.hinges, speed, self.density)
 
 
+MAX_STUDY_STEPS = 1_000_000_000
+"""Most time steps of one limit-cycle study, all its marches together (the Conner section's
+shipped study takes 3.5e6, about 30 s on one core)."""
+
+
+def study_steps(
+    n_speeds: int, n_amplitudes: int, continuation: bool, duration: float, step: float
+) -> int:
+    """Total time steps of a study of ``n_speeds`` x ``n_amplitudes`` marches (and the two
+    sweeps of ``continuation``) of ``duration`` [s] at ``step`` [s].
+
+    Raises
+    ------
+    InputError
+        Beyond :data:`MAX_STUDY_STEPS`, saying the total and the limit.
+    """
+    marches = n_speeds * n_amplitudes + (2 * n_speeds if continuation else 0)
+    total = marches * max(round(duration / step), 1)
+    if total > MAX_STUDY_STEPS:
+        raise InputError(
+            f"{n_speeds} speeds x {n_amplitudes} amplitudes"
+            + (f" + 2 sweeps of {n_speeds} speeds" if continuation else "")
+            + f" = {marches} marches of {duration:g} s at {step:g} s: {total:.4g} steps in "
+            f"all, above the limit of {MAX_STUDY_STEPS:.0e} for one study (about 3 hours of a "
+            "typical section's marches on one core): fewer speeds or amplitudes, or shorter "
+            "marches"
+        )
+    return total
+
+
 @dataclass(frozen=True)
 class LCOSweep:
     """The marches of a study.
@@ -152,6 +185,12 @@ class LCOSweep:
         check_number("settle", self.settle, lo=0.0, hi=0.9)
         check_number("history", self.history, unit="s", lo=0.0, hi=self.duration)
 
+    def steps(self, step: float) -> int:
+        """Total time steps of the study at a march step of ``step`` [s] (the open loop's
+        ``dt`` or the controller's period): :func:`study_steps`."""
+        n_v, n_a = len(self.speeds), len(self.amplitudes)
+        return study_steps(n_v, n_a, self.continuation, self.duration, step)
+
     def tasks(self) -> list[tuple]:
         """``(kind, speeds, amplitude)``: ``"point"`` marches and the two sweeps."""
         out = [("point", (v,), a) for v in self.speeds for a in self.amplitudes]
@@ -178,6 +217,8 @@ def march_task(shared: tuple, task: tuple) -> list[dict]:
             rows.append(_failed(kind, v, amp if x is None else np.nan, str(exc), "divergence"))
             x = None
             continue
+        except LawError:  # a Python law that fails fails everywhere: the study stops
+            raise
         except InputError as exc:
             rows.append(_failed(kind, v, amp if x is None else np.nan, str(exc)))
             x = None
