@@ -434,3 +434,22 @@ def test_lco_against_the_measured_rms(damped_study):
     plunge = np.array([100 * rows["down"][v]["rmss"]["plunge"] for v in speeds])
     m_plunge = np.interp(ratio[upper], MEASURED_PLUNGE[:, 0], MEASURED_PLUNGE[:, 1])
     assert np.all((plunge[upper] / m_plunge > 1.0) & (plunge[upper] / m_plunge < 3.5))
+
+
+def test_shipped_damped_scenario():
+    """``scenarios/conner_freeplay_lco_damped.toml``: the builtin section with the paper's
+    dampers from its ``[damping]`` table, named in the run's model line."""
+    from pathlib import Path
+
+    from aeroservo.files.scenario_file import load_scenario
+
+    path = Path(__file__).resolve().parent.parent / "scenarios" / "conner_freeplay_lco_damped.toml"
+    s = load_scenario(path)
+    assert s.section.damping == conner_section(damped="per_dof").damping
+    np.testing.assert_array_equal(
+        s.section.matrices.Cs.toarray(), conner_section(damped="per_dof").matrices.Cs.toarray()
+    )
+    assert s.wing_source == (
+        "builtin section conner (damping zeta per DOF = 0.0113, 0.01626, 0.0115, "
+        "plunge mass 1.558 kg/m)"
+    )
