@@ -120,7 +120,9 @@ def section_table(top: Table, kw: dict) -> None:
                 st.fail("damped", damped, "give section.damped or a [damping] table, not both")
             sec = conner_section(damped=damped, wagner=wagner)
             kw["section"] = sec if damping is None else replace(sec, damping=damping)
-            kw["wing_source"] = "builtin section conner" + (" (damped)" if damped else "")
+            kw["wing_source"] = "builtin section conner" + (
+                " (damped)" if damped else f" (damping {damping.describe()})" if damping else ""
+            )
             return
         st.check_keys(tuple(k for k in SECTION_KEYS if k != "flap_static_moment"), SECTION_KEYS)
         vals = {k: st.number(k, **SECTION_RANGES[k]) for k in SECTION_KEYS if st.has(k)}

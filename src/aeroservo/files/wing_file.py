@@ -60,7 +60,7 @@ ANALYSIS_KEYS = (
     "aero",
     "mach",
 )
-DAMPING_KEYS = ("ratio", "alpha", "beta", "g")
+DAMPING_KEYS = ("ratio", "alpha", "beta", "g", "dof_ratio", "plunge_mass")
 
 
 @dataclass(frozen=True)
@@ -259,14 +259,23 @@ def analysis_from_dict(
 
 def damping_from_dict(data: Mapping, where: str = "damping") -> StructuralDamping:
     """Structural damping from a ``[damping]`` table: ``ratio`` (a number or a list, one per
-    in-vacuo mode), ``alpha`` and ``beta`` (Rayleigh), or ``g`` (structural damping)."""
+    in-vacuo mode), ``alpha`` and ``beta`` (Rayleigh), ``g`` (structural damping), or
+    ``dof_ratio`` (per-DOF viscous ratios, with ``plunge_mass`` on a typical section)."""
     tbl = _check_keys(where, data, (), DAMPING_KEYS)
-    forms = [k for k in ("ratio", "g") if k in tbl] + (
+    forms = [k for k in ("ratio", "g", "dof_ratio") if k in tbl] + (
         ["alpha/beta"] if "alpha" in tbl or "beta" in tbl else []
     )
     if len(forms) > 1:
-        raise InputError(f"{where}: give one of ratio, g, or alpha and beta (given {forms})")
+        raise InputError(
+            f"{where}: give one of ratio, g, dof_ratio, or alpha and beta (given {forms})"
+        )
+    if "plunge_mass" in tbl and "dof_ratio" not in tbl:
+        raise InputError(
+            f"{where}.plunge_mass = {tbl['plunge_mass']!r}: only with dof_ratio (per-DOF damping)"
+        )
     try:
+        if "dof_ratio" in tbl:
+            return StructuralDamping.per_dof(tbl["dof_ratio"], tbl.get("plunge_mass"))
         if "ratio" in tbl:
             return StructuralDamping.modal(tbl["ratio"])
         if "g" in tbl:

@@ -38,7 +38,7 @@ class Terms:
         self.items: dict[str, list] = {}  # name -> matrix derivatives (two for a kink)
         self.kinks: dict[str, tuple[str, tuple[str, ...]]] = {}  # name -> (why, sides)
         self.damping = (
-            damping_derivatives(model.damping, self.am.Ms, self.am.Ks)
+            damping_derivatives(model.damping, self.am.Ms, self.am.Ks, self.am.dof_labels)
             if model.damping.active
             else None
         )

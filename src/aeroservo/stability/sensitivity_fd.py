@@ -49,8 +49,10 @@ def _damped(damping: StructuralDamping, name: str, value: float) -> StructuralDa
         beta = value if name == "damping.beta" else damping.beta
         return StructuralDamping.rayleigh(alpha, beta)
     ratios = list(damping.ratios)
-    i = 0 if name == "damping.ratio" else int(name[name.index("[") + 1 : name.index("]")])
+    i = int(name[name.index("[") + 1 : name.index("]")]) if "[" in name else 0
     ratios[i] = value
+    if damping.kind == "per_dof":
+        return StructuralDamping.per_dof(ratios, damping.plunge_mass)
     return StructuralDamping.modal(ratios if len(ratios) > 1 else ratios[0])
 
 

@@ -107,7 +107,9 @@ class AeroelasticModel:
         self.mesh: Mesh = build_mesh(wing, self.n_elements, self.load_stations)
         self.sweep_terms = check_sweep_terms(sweep_terms)
         am = assemble(wing, self.mesh, sweep_terms=self.sweep_terms)
-        self.matrices: AeroMatrices = replace(am, Cs=damping_matrix(self.damping, am.Ms, am.Ks))
+        self.matrices: AeroMatrices = replace(
+            am, Cs=damping_matrix(self.damping, am.Ms, am.Ks, am.dof_labels)
+        )
         self.properties = element_properties(wing, self.mesh)
         self._systems: dict[tuple[float, float], FirstOrderSystem] = {}
         self._parts: dict | None = None  # stiffness parts for label_modes

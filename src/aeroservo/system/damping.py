@@ -1,6 +1,7 @@
-"""Structural damping ``C_s`` (the seed's equation 1): modal ratios, Rayleigh, structural g.
+"""Structural damping ``C_s`` (the seed's equation 1): modal ratios, Rayleigh, structural g,
+per-DOF viscous ratios.
 
-Three forms, all giving a symmetric damping matrix on the structural unknowns that multiplies
+Four forms, all giving a symmetric damping matrix on the structural unknowns that multiplies
 the rates in ``Ms qdd + C_s qd + Ks q = f_aero``:
 
 * **modal**: a viscous damping ratio ``zeta_j`` per in-vacuo mode (one value for all, or a list
@@ -9,7 +10,11 @@ the rates in ``Ms qdd + C_s qd + Ks q = f_aero``:
   mode, so that each in-vacuo mode decays at ``zeta_j omega_j``;
 * **Rayleigh**: ``C_s = alpha Ms + beta Ks`` (``zeta_j = alpha / (2 omega_j) + beta omega_j / 2``);
 * **structural g** (Nastran's ``g``): the equivalent viscous ratio ``zeta_j = g / 2`` at every
-  in-vacuo mode (the damping of ``(1 + i g) K`` at resonance).
+  in-vacuo mode (the damping of ``(1 + i g) K`` at resonance);
+* **per DOF**: a viscous ratio per kind of unknown (plunge/bending, pitch/torsion, flap/control
+  rotation), on the modes of the uncoupled structure (:mod:`.dof_damping`); on a typical section
+  the damper ``c_i = 2 zeta_i sqrt(k_i m_ii)`` of each degree of freedom, as Conner et al.
+  (1997) define it (with ``plunge_mass``, their wing mass in the plunge damper).
 
 The matrix does not depend on speed or density: it is built once per model.
 """
@@ -24,6 +29,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..errors import InputError, check_number, check_quantity
+from .dof_damping import GAP, dense, dof_blocks, modal_terms, per_dof_derivatives
 
 __all__ = [
     "StructuralDamping",
@@ -31,9 +37,10 @@ __all__ = [
     "damping_derivatives",
     "damping_parameters",
     "NO_DAMPING",
+    "GAP",
 ]
 
-KINDS = ("none", "modal", "rayleigh", "structural_g")
+KINDS = ("none", "modal", "rayleigh", "structural_g", "per_dof")
 
 PLAUSIBLE_G = 0.2
 """Largest structural damping g [-] taken without a warning (g = 0.2 is zeta = 0.1; built
@@ -50,15 +57,21 @@ class StructuralDamping:
     Parameters
     ----------
     kind : str
-        ``"none"``, ``"modal"``, ``"rayleigh"`` or ``"structural_g"``.
+        ``"none"``, ``"modal"``, ``"rayleigh"``, ``"structural_g"`` or ``"per_dof"``.
     ratios : tuple of float
-        Modal viscous damping ratios [-], lowest mode first (``"modal"``).
+        Modal viscous damping ratios [-], lowest mode first (``"modal"``); per-DOF ratios
+        [-], one for every kind of unknown or one per kind: plunge/bending, pitch/torsion,
+        flap/control rotation (``"per_dof"``).
     alpha : float
         Mass-proportional coefficient [1/s] (``"rayleigh"``).
     beta : float
         Stiffness-proportional coefficient [s] (``"rayleigh"``).
     g : float
         Structural damping coefficient [-] (``"structural_g"``).
+    plunge_mass : float or None
+        Mass [kg/m] in a typical section's plunge damper ``2 zeta_h sqrt(k_h m)``
+        (``"per_dof"``; default the section's plunge inertia). Conner et al. (1997) use the
+        wing-and-flap mass ``m``, not the plunge inertia ``m_t`` with the supports.
     """
 
     kind: str = "none"
@@ -66,23 +79,40 @@ class StructuralDamping:
     alpha: float = 0.0
     beta: float = 0.0
     g: float = 0.0
+    plunge_mass: float | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise InputError(f"damping.kind = {self.kind!r}: allowed values are {list(KINDS)}")
-        if self.kind == "modal":
+        if self.kind in ("modal", "per_dof"):
+            key = "damping.ratio" if self.kind == "modal" else "damping.dof_ratio"
             r = self.ratios
             if isinstance(r, (int, float)) and not isinstance(r, bool):
                 r = (r,)
             if isinstance(r, (str, bytes)) or not isinstance(r, Sequence) or len(r) == 0:
                 raise InputError(
-                    f"damping.ratio = {self.ratios!r}: expected a damping ratio or a list of them"
+                    f"{key} = {self.ratios!r}: expected a damping ratio or a list of them"
+                )
+            if self.kind == "per_dof" and len(r) > 3:
+                raise InputError(
+                    f"{key} = {list(r)!r}: one ratio, or one per kind of unknown "
+                    "(plunge/bending, pitch/torsion, flap/control rotation): at most 3"
                 )
             vals = tuple(
-                check_number(f"damping.ratio[{i}]", v, lo=0.0, hi=1.0, hi_open=True)
+                check_number(f"{key}[{i}]", v, lo=0.0, hi=1.0, hi_open=True)
                 for i, v in enumerate(r)
             )
             object.__setattr__(self, "ratios", vals)
+        if self.plunge_mass is not None:
+            if self.kind != "per_dof":
+                raise InputError(
+                    f"damping.plunge_mass = {self.plunge_mass!r}: only with per-DOF ratios "
+                    "(dof_ratio)"
+                )
+            m = check_number("damping.plunge_mass", self.plunge_mass, unit="kg/m", lo=0.0)
+            if m <= 0.0:
+                raise InputError(f"damping.plunge_mass = {m!r}: must be > 0 kg/m")
+            object.__setattr__(self, "plunge_mass", m)
         if self.kind == "rayleigh":
             check_quantity("damping.alpha", self.alpha, "rayleigh_alpha")
             check_quantity("damping.beta", self.beta, "rayleigh_beta")
@@ -102,10 +132,12 @@ class StructuralDamping:
                 UserWarning,
                 stacklevel=4,
             )
-        big = [z for z in self.ratios if z > PLAUSIBLE_RATIO] if self.kind == "modal" else []
+        viscous = self.kind in ("modal", "per_dof")
+        big = [z for z in self.ratios if z > PLAUSIBLE_RATIO] if viscous else []
         if big:
+            key = "damping.ratio" if self.kind == "modal" else "damping.dof_ratio"
             warnings.warn(
-                f"damping.ratio = {big[0]:g} is {100 * big[0]:g} % of critical damping, far "
+                f"{key} = {big[0]:g} is {100 * big[0]:g} % of critical damping, far "
                 "above the 0.005 to 0.03 of built wings; the ratio is a fraction, not a "
                 f"percentage: for {big[0]:g} % write ratio = {big[0] / 100:g}",
                 UserWarning,
@@ -127,6 +159,16 @@ class StructuralDamping:
         """Structural damping g (``zeta = g / 2`` at every in-vacuo mode)."""
         return cls("structural_g", g=g)
 
+    @classmethod
+    def per_dof(
+        cls, ratios: float | Sequence[float], plunge_mass: float | None = None
+    ) -> StructuralDamping:
+        """Per-DOF viscous damping ratio(s) [-]: one for every kind of unknown, or one each for
+        plunge/bending, pitch/torsion and flap/control rotation (:mod:`.dof_damping`); on a
+        typical section the dampers ``2 zeta_i sqrt(k_i m_ii)``, with ``plunge_mass`` [kg/m]
+        in the plunge's if given."""
+        return cls("per_dof", ratios=ratios, plunge_mass=plunge_mass)
+
     @property
     def active(self) -> bool:
         return self.kind != "none" and (
@@ -138,6 +180,9 @@ class StructuralDamping:
         if self.kind == "modal":
             r = self.ratios
             return f"zeta = {r[0]:g}" if len(r) == 1 else "zeta = " + ", ".join(f"{z:g}" for z in r)
+        if self.kind == "per_dof":
+            mass = "" if self.plunge_mass is None else f", plunge mass {self.plunge_mass:g} kg/m"
+            return "zeta per DOF = " + ", ".join(f"{z:g}" for z in self.ratios) + mass
         if self.kind == "rayleigh":
             return f"Rayleigh {self.alpha:g} M + {self.beta:g} K"
         if self.kind == "structural_g":
@@ -148,6 +193,10 @@ class StructuralDamping:
         out: dict = {"kind": self.kind}
         if self.kind == "modal":
             out["ratio"] = list(self.ratios)
+        elif self.kind == "per_dof":
+            out["dof_ratio"] = list(self.ratios)
+            if self.plunge_mass is not None:
+                out["plunge_mass"] = self.plunge_mass
         elif self.kind == "rayleigh":
             out.update(alpha=self.alpha, beta=self.beta)
         elif self.kind == "structural_g":
@@ -155,7 +204,10 @@ class StructuralDamping:
         return out
 
     def mode_ratios(self, omega: np.ndarray) -> np.ndarray:
-        """Damping ratio of each in-vacuo mode of circular frequencies ``omega`` [rad/s]."""
+        """Damping ratio of each in-vacuo mode of circular frequencies ``omega`` [rad/s] (not
+        for per-DOF damping, whose ratios belong to the modes of the uncoupled structure)."""
+        if self.kind == "per_dof":
+            raise ValueError("per-DOF damping has no ratio per coupled in-vacuo mode")
         omega = np.asarray(omega, dtype=float)
         if self.kind == "modal":
             r = np.asarray(self.ratios)
@@ -171,7 +223,7 @@ class StructuralDamping:
 NO_DAMPING = StructuralDamping()
 
 
-def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
+def damping_matrix(damping: StructuralDamping, Ms, Ks, labels=None) -> sp.csr_matrix | None:
     """The structural damping matrix on the structural unknowns, or None without damping.
 
     Parameters
@@ -179,6 +231,8 @@ def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
     damping : StructuralDamping
     Ms, Ks : sparse or ndarray (n, n)
         Structural mass and stiffness.
+    labels : sequence of str, optional
+        The unknowns' labels (``AeroMatrices.dof_labels``); per-DOF damping needs them.
     """
     if not isinstance(damping, StructuralDamping):
         raise InputError(f"damping = {damping!r}: expected an aeroservo StructuralDamping")
@@ -188,6 +242,15 @@ def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
         return sp.csr_matrix(damping.alpha * Ms + damping.beta * Ks)
     M = Ms.toarray() if sp.issparse(Ms) else np.asarray(Ms, dtype=float)
     K = Ks.toarray() if sp.issparse(Ks) else np.asarray(Ks, dtype=float)
+    if damping.kind == "per_dof":
+        out = np.zeros_like(M)
+        for idx, m_b, k_b, zeta, _, _ in dof_blocks(
+            damping.ratios, damping.plunge_mass, M, K, _labels(labels, M)
+        ):
+            w2, phi = sla.eigh(k_b, m_b)
+            mp = m_b @ phi
+            out[np.ix_(idx, idx)] = (mp * (2.0 * zeta * np.sqrt(np.clip(w2, 0.0, None)))) @ mp.T
+        return sp.csr_matrix(out)
     w2, phi = sla.eigh(K, M)
     omega = np.sqrt(np.clip(w2, 0.0, None))
     c = 2.0 * damping.mode_ratios(omega) * omega
@@ -195,9 +258,13 @@ def damping_matrix(damping: StructuralDamping, Ms, Ks) -> sp.csr_matrix | None:
     return sp.csr_matrix((mp * c) @ mp.T)
 
 
-GAP = 1e-6
-"""In-vacuo eigenvalues closer than this (relative) with different damping ratios: the modal
-damping matrix has no derivative (which mode gets which ratio is undecided)."""
+def _labels(labels, M: np.ndarray):
+    if labels is None or len(labels) != M.shape[0]:
+        raise InputError(
+            "damping.dof_ratio: per-DOF damping needs the labels of the structural unknowns "
+            "(w, theta, phi, delta)"
+        )
+    return labels
 
 
 def damping_parameters(damping: StructuralDamping) -> dict[str, float]:
@@ -205,17 +272,18 @@ def damping_parameters(damping: StructuralDamping) -> dict[str, float]:
     ``damping.ratio[i]``, ``damping.alpha``, ``damping.beta``) and values; empty if undamped."""
     if not damping.active:
         return {}
-    if damping.kind == "modal":
+    if damping.kind in ("modal", "per_dof"):
+        key = "damping.ratio" if damping.kind == "modal" else "damping.dof_ratio"
         r = damping.ratios
         if len(r) == 1:
-            return {"damping.ratio": r[0]}
-        return {f"damping.ratio[{i}]": v for i, v in enumerate(r)}
+            return {key: r[0]}
+        return {f"{key}[{i}]": v for i, v in enumerate(r)}
     if damping.kind == "rayleigh":
         return {"damping.alpha": damping.alpha, "damping.beta": damping.beta}
     return {"damping.g": damping.g}
 
 
-def damping_derivatives(damping: StructuralDamping, Ms, Ks):
+def damping_derivatives(damping: StructuralDamping, Ms, Ks, labels=None):
     """Derivatives of the damping matrix, as two functions of one eigen-decomposition.
 
     Returns
@@ -225,7 +293,8 @@ def damping_derivatives(damping: StructuralDamping, Ms, Ks):
         by ``dMs, dKs`` (Rayleigh: ``alpha dMs + beta dKs``; modal and structural g: the
         eigenvector derivatives of ``Cs = Ms Phi diag(2 zeta_j omega_j) Phi^T Ms``, Nelson's
         closed form through the divided differences of ``f(lambda) = 2 zeta sqrt(lambda)``;
-        raises ValueError when two modes of different ratios coincide, see :data:`GAP`).
+        raises ValueError when two modes of different ratios coincide, see :data:`GAP`; per
+        DOF: the same on each uncoupled block, ``labels`` the unknowns' labels).
         ``d_own(name)`` gives ``dCs/dp`` for a name of :func:`damping_parameters`.
     """
     M = Ms.toarray() if sp.issparse(Ms) else np.asarray(Ms, dtype=float)
@@ -239,38 +308,12 @@ def damping_derivatives(damping: StructuralDamping, Ms, Ks):
             return sp.csr_matrix(M if name == "damping.alpha" else K)
 
         return d_structure, d_own
-    lam, phi = sla.eigh(K, M)
-    lam = np.clip(lam, 0.0, None)
-    s = np.sqrt(lam)
-    zeta = damping.mode_ratios(s)
-    f = 2.0 * zeta * s
-    mp = M @ phi
-    li, lj = lam[:, None], lam[None, :]
-    si, sj = s[:, None], s[None, :]
-    zi, zj = zeta[:, None], zeta[None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gap = lj - li
-        d1 = (zj * sj - zi * si) * 2.0 / gap
-        d2 = (zj * sj * lj - zi * si * li) * 2.0 / gap
-        same = zi == zj  # the closed forms of the divided differences of 2 zeta sqrt(lambda)
-        d1 = np.where(same, 2.0 * zi / (si + sj), d1)
-        d2 = np.where(same, 2.0 * zi * (li + si * sj + lj) / (si + sj), d2)
-    clash = ~same & (np.abs(gap) <= GAP * np.maximum(li, lj))
-    np.fill_diagonal(d1, zeta / s)
-    np.fill_diagonal(d2, 3.0 * zeta * s)
+    if damping.kind == "per_dof":
+        return per_dof_derivatives(damping.ratios, damping.plunge_mass, M, K, _labels(labels, M))
+    core, mp, s = modal_terms(M, K, damping.mode_ratios)
 
     def d_structure(dMs, dKs):
-        if clash.any():
-            i, j = np.argwhere(clash)[0]
-            raise ValueError(
-                f"in-vacuo modes {i + 1} and {j + 1} have the same frequency and different "
-                "damping ratios: the modal damping matrix has no derivative"
-            )
-        dm = dMs.toarray() if sp.issparse(dMs) else np.asarray(dMs)
-        dk = dKs.toarray() if sp.issparse(dKs) else np.asarray(dKs)
-        g = (phi.T @ dk @ phi) * d1 - (phi.T @ dm @ phi) * d2
-        outer = (dm @ phi * f) @ mp.T
-        return sp.csr_matrix(outer + outer.T + mp @ g @ mp.T)
+        return sp.csr_matrix(core(dense(dMs), dense(dKs)))
 
     def d_own(name):
         if name == "damping.g":

@@ -155,7 +155,8 @@ class TypicalSection:
         c = 1.0 if self.hinge is None else self.hinge
         aero = section_aero(self.semichord, self.a, c)
         ks = np.diag([self.k_plunge, self.k_pitch, self.k_flap])[:n, :n]
-        cs = damping_matrix(self.damping or NO_DAMPING, self.mass_matrix(), ks)
+        labels = ("w", "phi", "delta")[:n]
+        cs = damping_matrix(self.damping or NO_DAMPING, self.mass_matrix(), ks, labels)
 
         def csr(x):
             return sp.csr_matrix(np.atleast_2d(x))
@@ -176,7 +177,7 @@ class TypicalSection:
             E1=csr(aero.r_q[None, :n]),
             F1=csr(aero.r_d[None, :n]),
             W1=csr(aero.w[:n, None]),
-            dof_labels=("w", "phi", "delta")[:n],
+            dof_labels=labels,
             lag_labels=("0",),
             Cs=cs,
         )
@@ -203,6 +204,7 @@ CONNER = {
     "a": -0.5,
     "hinge": 0.5,
     "m_plunge": 3.3843,  # kg/m, plunge inertia with the supports (m_t)
+    "m_wing": 1.558,  # kg/m, wing and flap without the supports (m): the plunge damper's mass
     "S_alpha": 0.08587,  # kg m/m
     "I_alpha": 0.01347,  # kg m
     "S_beta": 0.00395,  # kg m/m
@@ -210,7 +212,7 @@ CONNER = {
     "k_h": 2818.8,  # N/m per m
     "k_alpha": 37.34,  # N m/rad per m
     "k_beta": 3.9,  # N m/rad per m
-    "zeta": (0.0113, 0.01626, 0.0115),  # modal ratios, plunge, pitch, flap
+    "zeta": (0.0113, 0.01626, 0.0115),  # viscous ratios, plunge, pitch, flap
     "gap": 0.0740,  # rad: total freeplay 4.24 deg (+-2.12 deg)
 }
 """The freeplay section of Conner, Tang, Dowell & Virgin (1997), J. Fluids Struct. 11, 89-109,
@@ -218,22 +220,36 @@ per unit span (SI; values as in ``shared/reference`` "Freeplay section")."""
 
 
 def conner_section(
-    k_flap: float = CONNER["k_beta"], *, damped: bool = False, wagner: object = "rt_jones"
+    k_flap: float = CONNER["k_beta"], *, damped: bool | str = False, wagner: object = "rt_jones"
 ) -> TypicalSection:
     """The 3-DOF section with flap of Conner et al. (1997), gap closed (hinge spring
     ``k_flap`` [N m/rad per m]).
 
     The plunge inertia is ``m_t`` (wing, flap and supports) and the pitch coupling the measured
-    static moment ``S_alpha`` (``x_alpha = S_alpha / (m_t b)``); ``damped`` adds the modal
-    viscous ratios (plunge, pitch, flap, in order of in-vacuo frequency; default undamped).
-    Linear flutter with the gap closed: 23.91 m/s with exact C(k), 23.73 m/s undamped with
-    R. T. Jones's lag states (this model: 23.74); flap free (``k_flap = 0``) about 6.5 m/s
-    (6.49). With ``damped`` this model gives 23.97 and 7.17 m/s where the reference script gives
-    23.84 and 6.65: its damping is not the modal damping of in-vacuo modes used here.
+    static moment ``S_alpha`` (``x_alpha = S_alpha / (m_t b)``). Linear flutter with the gap
+    closed: 23.91 m/s with exact C(k), 23.73 m/s undamped with R. T. Jones's lag states (this
+    model: 23.74); flap free (``k_flap = 0``) about 6.5 m/s (6.49).
+
+    ``damped``: False (default) undamped; ``"per_dof"`` the paper's damping, a viscous damper
+    ``2 zeta_i sqrt(k_i m_i)`` on each degree of freedom with the ratios ``CONNER["zeta"]``
+    and, in the plunge's, the wing mass ``m`` (``CONNER["m_wing"]``), not ``m_t``
+    (:meth:`~aeroservo.system.damping.StructuralDamping.per_dof`): 23.84 m/s, as the reference;
+    True or ``"modal"`` the same ratios as modal damping of the in-vacuo modes (23.97 m/s, not
+    the paper's). Flap free the reference's 6.65 m/s keeps the flap damper of the hinge spring
+    3.9 N m/rad; ``conner_section(0.0, damped="per_dof")`` damps the flap on its own spring,
+    zero (6.90 m/s). The freeplay section keeps the spring and its damper (the law removes the
+    spring inside the gap), as the paper does.
     """
     from .damping import StructuralDamping
 
     c, b = CONNER, CONNER["semichord"]
+    if damped not in (False, True, "modal", "per_dof"):
+        raise InputError(f"damped = {damped!r}: allowed values are False, True, 'modal', 'per_dof'")
+    damping = None
+    if damped == "per_dof":
+        damping = StructuralDamping.per_dof(list(c["zeta"]), plunge_mass=c["m_wing"])
+    elif damped:
+        damping = StructuralDamping.modal(list(c["zeta"]))
     return TypicalSection(
         semichord=b,
         a=c["a"],
@@ -247,5 +263,5 @@ def conner_section(
         flap_inertia=c["I_beta"],
         k_flap=k_flap,
         wagner=wagner,
-        damping=StructuralDamping.modal(list(c["zeta"])) if damped else None,
+        damping=damping,
     )
