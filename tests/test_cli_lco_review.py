@@ -400,7 +400,7 @@ DAMAGED = {
     "rows_empty": "'rows' is empty: a limit-cycle result has at least one march",
     "settings_gap_text": "settings.gap = 'x': expected a positive gap [rad] or null",
     "settings_duration_text": "settings.duration = 'long': not what aeroservo writes",
-    "npz_corrupt": "r_histories.npz: not a .npz archive of limit-cycle histories",
+    "npz_corrupt": "r_histories.npz: not a .npz archive",
     "npz_no_t": "r_histories.npz: row0/t: missing (the history of row 0)",
     "npz_lengths_differ": "r_histories.npz: row0/flap_rotation: 3 values, its row0/t 5",
     "npz_text": "r_histories.npz: array 'row0/t' of <U1 values: expected real numbers",

@@ -220,10 +220,10 @@ def _write_broken(kind: str, good, folder):
 
 
 BROKEN = {
-    "truncated": "not an aeroservo result file",
+    "truncated": "not a .npz archive (no zip directory)",
     "json-summary": "a JSON summary?",
     "foreign": "no JSON header",
-    "pickled": "not an aeroservo result file",
+    "pickled": "array 'meta' holds Python objects (pickled)",
     "missing-key": "no array 'eigenvalues'",
     "wrong-shape": "'eigenvalues'",
     "wrong-rows": "rows for",

@@ -101,7 +101,7 @@ def add_parsers(sub) -> None:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..atomic import save_figure
+    from ..atomic import atomic_write_set, figure_writer
     from ..errors import InputError
     from ..files.results import load_result
     from ..files.user_files import check_readable
@@ -140,11 +140,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     which = res.figure_kinds if several and args.kind is None and args.out is None else (kind,)
     if kind not in res.figure_kinds:
         raise InputError(_missing(res, src, args, kind))
+    items = []  # every figure drawn first, then written as a set: all of them or none
     for k in which:
         fig = res.plot(k, **_options(res, k, args))
         name = k.replace("-", "_")
         path = out if args.out or not several else src.with_name(f"{src.stem}_{name}.png")
-        save_figure(fig, path, dpi=130)
+        items.append((path, figure_writer(fig, path, dpi=130)))
+    for path in atomic_write_set(items):
         print(f"plot written to {path}")
     return 0
 
@@ -173,13 +175,8 @@ def _missing(res, src, args: argparse.Namespace, kind: str) -> str:
             f"--kind = {kind!r}: {args.result} has no time histories (its "
             f"{src.stem}_histories.npz is not next to it)"
         )
-    if kind in ("correlated", "spanwise"):
-        need = (
-            "loads at two or more stations (root loads, load_stations)"
-            if kind == "spanwise"
-            else "both root_bending_moment and root_torque as loads"
-        )
-        return f"--kind = {kind!r}: {args.result} has not {need}"
+    if _what(res) == "gust loads":
+        return f"{'--kind = ' + repr(kind) + ': ' if args.kind else ''}{src}: {res.missing(kind)}"
     if not res.modes:
         return f"{args.result}: the file has no mode shapes"
     return f"{args.result}: no flutter in the sweep, so no flutter mode"

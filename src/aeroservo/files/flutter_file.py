@@ -11,9 +11,7 @@ aeroservo version. No pickled objects: a damaged or foreign file gives one clear
 from __future__ import annotations
 
 import dataclasses
-import io
 import json
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,7 +23,7 @@ from ..result_shape import Result
 from ..stability.near_critical import NearCritical
 from ..stability.result import Crossing, FlutterResult
 from .summaries import json_text
-from .user_files import MAX_RESULT_BYTES, read_bytes
+from .user_files import MAX_JSON_MEMORY, file_head, json_memory, read_npz
 
 __all__ = ["FORMAT", "SavedFlutter", "flutter_writer", "saved_writer", "read_flutter"]
 
@@ -371,27 +369,27 @@ def read_flutter(path: Path, data: dict, meta: dict) -> SavedFlutter:
 
 def open_npz(path: Path) -> tuple[dict, dict]:
     """The arrays and JSON header of an aeroservo ``.npz`` result (one clear error otherwise)."""
-    raw = read_bytes(path, what="aeroservo result file (.npz)", limit=MAX_RESULT_BYTES)
-    if raw[:4] not in (b"PK\x03\x04", b"PK\x05\x06"):  # an archive (or an empty one)
+    what = "aeroservo result file (.npz)"
+    head = file_head(path, 4, what)
+    if head not in (b"PK\x03\x04", b"PK\x05\x06"):  # an archive (or an empty one)
         hint = "; a JSON summary? save a sweep with 'aeroservo flutter ... --save FILE.npz'"
         raise InputError(
             f"{path}: not an aeroservo result file (not a .npz archive"
-            + (hint if raw[:1] in (b"{", b"[") else "")
+            + (hint if head[:1] in (b"{", b"[") else "")
             + ")"
         )
-    try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
-            data = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
-        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{path}: not an aeroservo result file ({why})") from None
+    data = read_npz(path, what=what)
     raw = data.get("meta")
     if raw is None or raw.dtype.kind != "U" or raw.ndim != 0:
         raise InputError(f"{path}: not an aeroservo result file (no JSON header 'meta')")
+    text = str(raw)
+    if json_memory(text) > MAX_JSON_MEMORY:
+        raise InputError(f"{path}: the result header is too large ({len(text)} characters)")
     try:
-        meta = json.loads(str(raw))
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: the result header is not valid JSON ({exc.msg})") from None
+        meta = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        why = getattr(exc, "msg", "nested too deeply")
+        raise InputError(f"{path}: the result header is not valid JSON ({why})") from None
     if not isinstance(meta, dict):
         raise InputError(f"{path}: the result header is not a JSON object")
     return data, meta

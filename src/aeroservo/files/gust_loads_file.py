@@ -9,8 +9,6 @@ result (the figures redraw from it). No pickled objects: a damaged or foreign fi
 
 from __future__ import annotations
 
-import io
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -19,10 +17,9 @@ from ..errors import InputError
 from ..studies.gust.results import GustLoadsResult
 from .summaries import json_text
 from .user_files import (
-    MAX_RESULT_BYTES,
     json_of_format,
     json_output,
-    read_bytes,
+    read_npz,
     read_result_json,
     write_result_items,
 )
@@ -38,7 +35,6 @@ __all__ = [
 FORMAT = "aeroservo-gust-loads-2"
 """Format 2 (issue 38): ``time_at_limit`` [s] per control replaces format 1's ``limited``
 (a share of the samples, which depended on the length of the march)."""
-_RECORD_KEYS = ("point", "loop", "loads", "histories", "history_loads", "time_at_limit")
 
 
 def _json_writer(result: GustLoadsResult, summary: dict, npz: Path):
@@ -175,30 +171,18 @@ def load_gust_loads(path: str | Path) -> GustLoadsResult:
     InputError
         The file is missing, not a gust-loads result, or its NPZ is missing or incomplete.
     """
+    from .gust_loads_checks import check_arrays, check_settings, checked_records
+
     path, doc = read_result_json(path, "gust-loads result", FORMAT, ("aeroservo-gust-loads-1",))
-    records = doc.get("records")
-    if not isinstance(records, list) or not all(
-        isinstance(r, dict) and all(k in r for k in _RECORD_KEYS) for r in records
-    ):
-        _fail(path, f"'records' must be a list of records with {list(_RECORD_KEYS)}")
+    records = checked_records(path, doc.get("records"))
     name = doc.get("arrays")
     if not isinstance(name, str) or Path(name).name != name or not name.endswith(".npz"):
         _fail(path, f"'arrays' = {name!r}: expected the name of a .npz file next to it")
     npz = path.parent / name
-    raw = read_bytes(npz, what="gust-loads histories (.npz)", limit=MAX_RESULT_BYTES)
-    try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
-        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{npz}: not a .npz archive of gust histories ({why})") from None
-    for r in records:
-        for sides in r["histories"].values():
-            for key in sides.values():
-                for end in ("_t", "_gust", "_y"):
-                    if key + end not in arrays:
-                        raise InputError(f"{npz}: missing array {key + end!r} (named by {path})")
-    units, settings = doc.get("units", {}), doc.get("settings", {})
-    if not isinstance(units, dict) or not isinstance(settings, dict):
-        _fail(path, "'units' and 'settings' must be tables")
-    return GustLoadsResult(str(doc.get("name", path.stem)), records, arrays, units, settings)
+    arrays = read_npz(npz, what="gust-loads histories (.npz)")
+    check_arrays(path, npz, records, arrays)
+    units, settings = check_settings(path, doc.get("units"), doc.get("settings"))
+    name = doc.get("name") or path.stem
+    if not isinstance(name, str):
+        _fail(path, f"'name' = {name!r}: expected a text")
+    return GustLoadsResult(name, records, arrays, units, settings)

@@ -13,7 +13,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -22,10 +21,9 @@ from ..errors import InputError
 from ..studies.lco.result import TABLE_COLUMNS, LCOResult
 from .summaries import finite, json_text
 from .user_files import (
-    MAX_RESULT_BYTES,
     json_of_format,
     json_output,
-    read_bytes,
+    read_npz,
     read_result_json,
     write_result_items,
 )
@@ -272,6 +270,8 @@ def _check_settings(path: Path, settings: dict) -> None:
             ok = isinstance(v, list) and all(
                 isinstance(x, item) and not isinstance(x, bool) for x in v
             )
+            if ok and item is not str:  # the speeds scale the figure's axis: some, finite
+                ok = all(map(math.isfinite, v)) and (k != "speeds" or bool(v))
         else:
             ok = isinstance(v, kind)
         if not ok:
@@ -292,13 +292,7 @@ def _histories(path: Path, name: object, n_rows: int, reference: object = None) 
     npz = path.parent / name
     if not npz.is_file():
         return {}
-    raw = read_bytes(npz, what="limit-cycle histories (.npz)", limit=MAX_RESULT_BYTES)
-    try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, RuntimeError) as exc:
-        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{npz}: not a .npz archive of limit-cycle histories ({why})") from None
+    arrays = read_npz(npz, what="limit-cycle histories (.npz)")
     out: dict = {}
     for key, v in arrays.items():
         row, sep, signal = key.partition("/")

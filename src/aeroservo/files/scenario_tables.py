@@ -144,7 +144,7 @@ def trade_table(tbl: Table, base: Path) -> TradeOptions:
     ``closed_loop = false``: the open-loop flutter boundary of each case only (no controller);
     ``masses[i].<key>`` parameters sweep the wing's concentrated masses."""
     from ..studies.trade.mass_parameters import mass_parameter
-    from ..studies.trade.study import PARAMETERS
+    from ..studies.trade.study import LINEAR_TYPES, PARAMETERS
 
     closed_loop = tbl.boolean("closed_loop", True)
     tbl.check_keys(
@@ -164,11 +164,13 @@ def trade_table(tbl: Table, base: Path) -> TradeOptions:
     spec = None
     if closed_loop or tbl.has("controller"):
         spec = controller(tbl, tbl.path("controller", base, required=True), "controller")
-    if spec is not None and spec.type not in ("lqr", "lqg"):
+    if spec is not None and spec.type not in LINEAR_TYPES:
         tbl.fail(
             "controller",
             tbl.data["controller"],
-            f"a trade study needs a linear controller (lqr or lqg), this one is {spec.type!r}",
+            f"a trade study needs a controller with a linear law, one of {list(LINEAR_TYPES)} "
+            f"(the closed-loop flutter boundary is an eigenvalue analysis of the linear loop); "
+            f"this one is {spec.type!r}",
         )
     masses = tuple(k for k in tbl.table("parameters").data if mass_parameter(k) is not None)
     pt = tbl.table("parameters").check_keys((), (*PARAMETERS, *masses))

@@ -352,11 +352,14 @@ def gust_figures(result, which=FIGURES) -> dict:
 
 
 def drawable(result, span: dict | None = None) -> dict:
-    """Whether the optional figures of a run can be drawn, by file suffix: ``correlated``
-    (both loads of :data:`CORRELATED`) and ``spanwise`` (loads at two or more stations;
-    ``span``: :func:`~aeroservo.studies.gust.span_plots.span_loads` when known)."""
+    """Whether the figures of a run can be drawn, by file suffix: any with loads at a flight
+    point at least (a study whose every point was skipped has none), ``correlated`` with both
+    loads of :data:`CORRELATED` and ``spanwise`` with loads at two or more stations (``span``:
+    :func:`~aeroservo.studies.gust.span_plots.span_loads` when known)."""
     from .span_plots import span_loads
 
+    if not result.records:
+        return dict.fromkeys(FIGURES, False)
     return {
         "correlated": all(n in result.loads for n in CORRELATED),
         "spanwise": bool(span_loads(result) if span is None else span),

@@ -266,13 +266,16 @@ class GustLoadsResult(Result):
         kind = kind or "envelope"
         figs = gust_figures(self, (kind.replace("-", "_"),))
         if not figs:
-            need = (
-                "loads at two or more stations (root loads, load_stations)"
-                if kind == "spanwise"
-                else "both root_bending_moment and root_torque as loads"
-            )
-            raise InputError(f"kind = {kind!r}: the result has not {need}")
+            raise InputError(f"kind = {kind!r}: {self.missing(kind)}")
         return next(iter(figs.values()))
+
+    def missing(self, kind: str) -> str:
+        """Why the figure ``kind`` cannot be drawn from this result (one line)."""
+        if not self.records:
+            return "the result has no loads (no flight point was computed; its summary says why)"
+        if kind == "spanwise":
+            return "the result has not loads at two or more stations (root loads, load_stations)"
+        return "the result has not both root_bending_moment and root_torque as loads"
 
     def summary(self) -> str:
         """A loads engineer's summary: worst limit load per load and loop, GLA, flags."""

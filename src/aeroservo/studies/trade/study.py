@@ -131,7 +131,7 @@ METRICS: dict[str, tuple[str, str]] = {
 }
 """Numeric results of a case: name -> (unit, description)."""
 
-_LINEAR_TYPES = ("lqr", "lqg", "mpc", "hinf", "linear", "gain")
+LINEAR_TYPES = ("lqr", "lqg", "mpc", "hinf", "linear", "gain")
 _BRYSON_TYPES = ("lqr", "lqg", "mpc", "hinf")
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
@@ -349,10 +349,10 @@ class TradeStudy:
                 f"controller = {spec!r}: expected a ControllerSpec (load_controller(path)); "
                 "only closed_loop = false studies run without one"
             )
-        if spec.type not in _LINEAR_TYPES:
+        if spec.type not in LINEAR_TYPES:
             raise InputError(
                 f"controller.type = {spec.type!r}: a trade study needs a controller with a "
-                f"linear law, one of {list(_LINEAR_TYPES)} (the closed-loop flutter boundary is "
+                f"linear law, one of {list(LINEAR_TYPES)} (the closed-loop flutter boundary is "
                 "an eigenvalue analysis of the linear loop)"
             )
         if "bryson_hinge_moment" in self.parameters and spec.type not in _BRYSON_TYPES:
