@@ -123,16 +123,22 @@ def test_lco_command_writes_the_set(cli_run):
         if name.endswith(".png"):
             assert (out / name).read_bytes()[:8] == PNG
         assert "wrote " in text and str(out / name) in text
-    assert "limit cycles from 14 to 14 m/s" in text and "divergent motion from 25 m/s" in text
+    assert "sustained oscillations at 14 m/s" in text and "\n  periodic at 14 m/s:" in text
+    assert "divergent motion from 25 m/s" in text
     assert "describing function: stable limit cycles" in text
     assert re.search(r"linear flutter speed, open loop with every spring closed: 23\.7\d m/s", text)
     doc = json.loads((out / f"{STEM}.json").read_text())
     assert doc["kind"] == "lco" and doc["lco_onset"] == 14.0 and doc["diverged_from"] == 25.0
+    assert list(doc["lco_classes"]) == ["periodic"] and doc["lco_classes"]["periodic"][
+        "speeds"
+    ] == [14.0]
     assert sorted(Path(p).name for p in doc["files"].values()) == sorted(FILES)
     assert len(doc["rows"]) == 3 * 2 + 2 * 3 and "history" not in doc["rows"][0]
     assert (out / f"{STEM}_summary.txt").read_text() == doc["summary_text"] + "\n"
     head = (out / f"{STEM}.csv").read_text().splitlines()[0]
-    assert head.startswith("start,speed [m/s],initial [rad],kind,confidence,frequency [Hz],")
+    assert head.startswith(
+        "start,speed [m/s],initial [rad],kind,confidence,frequency [Hz],modulation [Hz],"
+    )
     branches = (out / f"{STEM}_branches.csv").read_text().splitlines()
     assert branches[0] == (
         "branch,element,amplitude [rad],amplitude_per_gap [-],speed [m/s],frequency [Hz],"

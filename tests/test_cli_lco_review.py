@@ -486,7 +486,7 @@ def test_csv_units_in_the_header(result_dir):
 # -- a coarse step is noted -----------------------------------------------------------------------
 def test_coarse_step_noted(tmp_path):
     """At 0.02 s the march of the 12 Hz limit cycle has 4 steps per cycle: switches are missed
-    (the verdict changes from lco to aperiodic), so the run says so; at 0.001 s it does not."""
+    (the verdict is no longer lco), so the run says so; at 0.001 s it does not."""
     text = _edit(
         SECTION,
         [

@@ -598,17 +598,21 @@ def test_growing_is_a_moderate_divergence(study):
 
 
 def test_summary_numbers_are_the_rows(study):
-    """The summary's limit-cycle range, amplitudes per gap, frequencies, divergence speed and
-    the describing-function comparison are computed from the rows (and the branches)."""
+    """The summary's range of sustained oscillations (issue 40: every class, each named; here
+    periodic only), amplitudes and RMS per gap, frequencies, divergence speed and the
+    describing-function comparison are computed from the rows (and the branches)."""
     text = study.summary()
     lco = study.lco_rows()
-    assert lco
+    assert lco and study.sustained_rows() == lco
     v = [r["speed"] for r in lco]
     a = [r["amplitude_per_gap"] for r in lco]
+    rms = [r["rms_per_gap"] for r in lco]
     f = [r["frequency"] for r in lco]
+    assert len(set(v)) == 1  # one speed: said once
     assert (
-        f"limit cycles from {min(v):.4g} to {max(v):.4g} m/s, amplitude (half peak-to-peak of "
-        f"flap) {min(a):.3g} to {max(a):.3g} x gap, {min(f):.3g} to {max(f):.3g} Hz" in text
+        f"sustained oscillations at {v[0]:.4g} m/s (half peak-to-peak and RMS of flap):\n"
+        f"  periodic at {v[0]:.4g} m/s: amplitude {min(a):.3g} to {max(a):.3g} x gap, RMS "
+        f"{min(rms):.3g} to {max(rms):.3g} x gap, {min(f):.3g} Hz\n" in text
     )
     div = [r["speed"] for r in study.rows if r["kind"] == "divergence"]
     assert f"divergent motion from {min(div):.4g} m/s" in text

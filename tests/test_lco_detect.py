@@ -208,25 +208,30 @@ def test_scale_sets_what_counts_as_rest():
     assert classify(t, x, scale=1e-6).kind == "lco"  # a 1e-8 LCO matters for a 1e-6 gap
 
 
-# ---------------------------------------------------------------------------- aperiodic
+# ------------------------------------------------- sustained, not periodic (issue 40)
+# A bounded, stationary motion is a sustained oscillation whatever its class; these were
+# "aperiodic" (not settled) before issue 40. tests/test_lco_verdicts.py has randomized ones.
 
 
 @pytest.mark.parametrize("r, ratio", [(0.6, 1 + (math.sqrt(5) - 1) / 8), (0.3, math.sqrt(2))])
-def test_beating_of_incommensurate_sines_is_aperiodic(r, ratio):
+def test_beating_of_incommensurate_sines_is_quasi_periodic(r, ratio):
     """sin(w1 t) + r sin(w2 t) with c = r w2 / w1 < 1: the extremes (zeros of
     cos(w1 t) + c cos(w2 t)) stay within asin(c) / w1 of those of sin(w1 t), so the mean
-    cycle rate is f1 to 2 asin(c) / (w1 span), span > T - 3 / f1."""
+    cycle rate is f1 to 2 asin(c) / (w1 span), span > T - 3 / f1. Its spectrum is two lines:
+    the carrier f1 (within a hundredth of a bin) and the modulation f2 - f1."""
     f1, t = 1.0, np.arange(0.0, 200.0, 1e-3)
     v = classify(t, np.sin(2 * np.pi * f1 * t) + r * np.sin(2 * np.pi * ratio * f1 * t))
-    assert (v.kind, v.confidence) == ("aperiodic", "high"), v.reason
-    span = v.window[1] - v.window[0] - 3 / f1
-    c = r * ratio
-    assert v.frequency == pytest.approx(f1, rel=2 * math.asin(c) / (2 * np.pi * f1 * span))
+    assert (v.kind, v.confidence) == ("quasi-periodic", "high"), v.reason
+    assert v.sustained
+    span = v.window[1] - v.window[0]
+    assert v.frequency == pytest.approx(f1, abs=0.02 / span)
+    assert v.modulation == pytest.approx((ratio - 1) * f1, abs=0.02 / span)
+    assert v.broadband < 1e-6
     assert v.peak["signal"] <= 1 + r
 
 
 @pytest.mark.parametrize("component", [0, 2])
-def test_lorenz_attractor_is_aperiodic(component):
+def test_lorenz_attractor_is_chaotic(component):
     sol = solve_ivp(
         lambda _, y: [10 * (y[1] - y[0]), y[0] * (28 - y[2]) - y[1], y[0] * y[1] - 8 / 3 * y[2]],
         (0.0, 100.0),
@@ -236,19 +241,22 @@ def test_lorenz_attractor_is_aperiodic(component):
         atol=1e-9,
     )
     v = classify(sol.t, sol.y[component])
-    assert v.kind == "aperiodic", v.reason
+    assert v.kind == "chaotic", v.reason
     assert v.confidence in ("high", "medium")
+    assert v.broadband > 0.02 and math.isnan(v.modulation)
 
 
-def test_logistic_map_driven_amplitudes_are_aperiodic():
-    """Cycle amplitudes from the logistic map at r = 4 (chaotic), one per period."""
+def test_logistic_map_driven_amplitudes_are_chaotic():
+    """Cycle amplitudes from the logistic map at r = 4 (chaotic), one per period: a 1 Hz line
+    on a continuous spectrum."""
     a = np.empty(60)
     a[0] = 0.3
     for k in range(59):
         a[k + 1] = 4 * a[k] * (1 - a[k])
     t = np.arange(0.0, 60.0, 1e-3)
     v = classify(t, (0.5 + a[t.astype(int)]) * np.sin(2 * np.pi * t))
-    assert v.kind == "aperiodic", v.reason
+    assert v.kind == "chaotic", v.reason
+    assert v.frequency == pytest.approx(1.0, abs=0.02 / 30)
 
 
 # ---------------------------------------------------------------------------- undecided, NaN
@@ -291,8 +299,9 @@ def test_as_dict_is_json():
     assert d["kind"] == "lco" and d["window"] == list(v.window)
     assert set(d) == {
         "kind", "confidence", "reason", "frequency", "peak", "rms", "mean",
-        "window", "cycles", "growth", "reference",
+        "window", "cycles", "growth", "reference", "modulation", "broadband",
     }  # fmt: skip
+    assert d["modulation"] is None and d["broadband"] is None  # a limit cycle has neither
 
 
 # ---------------------------------------------------------------------------- bad input

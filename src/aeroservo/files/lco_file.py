@@ -30,12 +30,18 @@ from .user_files import (
 
 __all__ = ["FORMAT", "lco_items", "write_lco", "load_lco", "is_lco_file", "TABLE_UNITS"]
 
-FORMAT = "aeroservo-lco-1"
+FORMAT = "aeroservo-lco-2"
+"""Version 2 (issue 40): rows have ``modulation`` [Hz] and the verdicts name sustained
+oscillations of every class ("lco", "quasi-periodic", "chaotic") and "unsettled" motion."""
+OLDER = ("aeroservo-lco-1",)
+"""Formats of earlier versions (refused with a message that says so: run the study again; their
+verdicts called sustained quasi-periodic and chaotic oscillations 'aperiodic')."""
 
 TABLE_UNITS = {
     "speed": "m/s",
     "initial": "rad",
     "frequency": "Hz",
+    "modulation": "Hz",
     "amplitude": "rad",
     "rms": "rad",
     "mean": "rad",
@@ -174,9 +180,9 @@ def write_lco(result: LCOResult, path: str | Path, summary: dict | None = None) 
 
 
 def is_lco_file(path: str | Path) -> bool:
-    """Whether ``path`` is a ``.json`` file written by :func:`write_lco` (its first
-    kilobytes name the format)."""
-    return json_of_format(path, FORMAT)
+    """Whether ``path`` is a ``.json`` file written by :func:`write_lco`, of this version or an
+    older one (its first kilobytes name the format)."""
+    return any(json_of_format(path, f) for f in (FORMAT, *OLDER))
 
 
 def _fail(path: Path, what: str):
@@ -191,11 +197,12 @@ def load_lco(path: str | Path) -> LCOResult:
     Raises
     ------
     InputError
-        The file is missing or not a limit-cycle result, or its NPZ is damaged.
+        The file is missing or not a limit-cycle result, of an older format (run the study
+        again), or its NPZ is damaged.
     """
     from ..stability.describing_function import DescribingBranches
 
-    path, doc = read_result_json(path, "limit-cycle result", FORMAT)
+    path, doc = read_result_json(path, "limit-cycle result", FORMAT, older=OLDER)
     rows, settings = doc.get("rows"), doc.get("settings")
     if not isinstance(rows, list) or not all(
         isinstance(r, dict) and all(k in r for k in TABLE_COLUMNS) for r in rows

@@ -6,15 +6,20 @@ import numpy as np
 
 from ..._figures import new_figure
 from ...errors import InputError
+from ...simulate.lco_detect import SUSTAINED
 
 __all__ = ["plot_bifurcation", "plot_histories"]
 
 _MARK = {
+    "quasi-periodic": ("D", None),
+    "chaotic": ("*", None),
     "decay": ("o", "none"),
     "growing": ("v", "none"),
-    "aperiodic": ("^", None),
+    "unsettled": ("^", "none"),
     "undecided": ("s", "none"),
 }
+_SIZED = (*SUSTAINED, "growing", "unsettled", "undecided")
+"""Verdicts drawn at their amplitude."""
 
 
 def _scale(result, per_gap: bool) -> tuple[float, str]:
@@ -27,11 +32,12 @@ def _scale(result, per_gap: bool) -> tuple[float, str]:
 def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool = True):
     """LCO amplitude (half peak-to-peak of the reference rotation) against airspeed.
 
-    Points marched from rest with each initial rotation are dots (colour: initial rotation);
-    the up and down sweeps (continuation) are lines with ``>`` and ``<`` markers; marches that
-    decayed are open circles at zero, that diverged crosses at the top, that were aperiodic
-    or undecided triangles and squares, and that were still growing (not settled) open
-    down-triangles, at their amplitude. The describing-function branches are
+    Points marched from rest with each initial rotation are dots where they settled in a limit
+    cycle (colour: initial rotation), diamonds in a quasi-periodic and stars in a chaotic
+    oscillation; the up and down sweeps (continuation) are lines with ``>`` and ``<`` markers;
+    marches that decayed are open circles at zero, that diverged crosses at the top, that were
+    unsettled or undecided open triangles and squares, and that were still growing (not
+    settled) open down-triangles, at their amplitude. The describing-function branches are
     drawn over it (solid stable, dashed unstable).
     """
     if ax is None:
@@ -39,9 +45,7 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
     k, ylabel = _scale(result, per_gap)
     rows = result.rows
     finite = [
-        r["amplitude"] * k
-        for r in rows
-        if r["kind"] in ("lco", "growing", "aperiodic", "undecided") and np.isfinite(r["amplitude"])
+        r["amplitude"] * k for r in rows if r["kind"] in _SIZED and np.isfinite(r["amplitude"])
     ]
     top = 1.15 * max(finite + [1.0 if per_gap and result.gap else 1e-3])
     amps = sorted({r["initial"] for r in rows if r["start"] == "point"})
@@ -58,7 +62,8 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
         for kind, (m, face) in _MARK.items():
             sel = [r for r in pts if r["kind"] == kind]
             y = [0.0 if kind == "decay" else r["amplitude"] * k for r in sel]
-            ax.plot([r["speed"] for r in sel], y, m, color=col, mfc=face or col, ms=5, zorder=3)
+            ms = 9 if m == "*" else 5
+            ax.plot([r["speed"] for r in sel], y, m, color=col, mfc=face or col, ms=ms, zorder=3)
         div = [r for r in pts if r["kind"] in ("divergence", "failed")]
         ax.plot([r["speed"] for r in div], [top] * len(div), "x", color=col, ms=7, zorder=3)
     for start, m, col in (("up", ">", "tab:red"), ("down", "<", "tab:blue")):
@@ -79,9 +84,11 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
 
         plot_describing(result.branches, ax=ax, per_gap=per_gap)
         ax.set_yscale("linear")
+    ax.plot([], [], "D", color="grey", label="quasi-periodic (sustained)")
+    ax.plot([], [], "*", color="grey", ms=9, label="chaotic (sustained)")
     ax.plot([], [], "o", color="grey", mfc="none", label="decays (drawn at 0)")
     ax.plot([], [], "v", color="grey", mfc="none", label="still growing (not settled)")
-    ax.plot([], [], "^", color="grey", label="aperiodic")
+    ax.plot([], [], "^", color="grey", mfc="none", label="unsettled")
     ax.plot([], [], "x", color="grey", label="diverges (drawn at the top)")
     ax.set_ylim(-0.03 * top, 1.05 * top)
     v = result.settings.get("speeds", [r["speed"] for r in rows])
@@ -104,15 +111,15 @@ def plot_bifurcation(result, ax=None, *, per_gap: bool = True, describing: bool 
 
 def plot_histories(result, speeds=None, *, n: int = 4, signals=None):
     """The end of the marches at a few speeds: the reference rotation (per gap) and its
-    hinge moment, one row per speed (default: up to ``n`` speeds where a limit cycle settled,
-    spread over the range; marches from rest with the largest initial rotation)."""
+    hinge moment, one row per speed (default: up to ``n`` speeds where a sustained oscillation
+    settled, spread over the range; marches from rest with the largest initial rotation)."""
     rows = [r for r in result.rows if r["start"] == "point" and r["history"]]
     if not rows:
         raise InputError("the result has no time histories")
     a_max = max(r["initial"] for r in rows)
     rows = [r for r in rows if r["initial"] == a_max]
     if speeds is None:
-        pick = [r for r in rows if r["kind"] == "lco"] or rows
+        pick = [r for r in rows if r["kind"] in SUSTAINED] or rows
         idx = np.unique(np.linspace(0, len(pick) - 1, min(n, len(pick))).round().astype(int))
         chosen = [pick[i] for i in idx]
     else:

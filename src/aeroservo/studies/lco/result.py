@@ -2,7 +2,10 @@
 
 Amplitudes are those of the rotation of the reference element (the first nonlinear hinge):
 half its peak-to-peak over the settled window (``amplitude``) and its RMS about the window mean
-(``rms``) [rad], and both per total gap (``*_per_gap``). Figures: :mod:`.plots`.
+(``rms``) [rad], and both per total gap (``*_per_gap``). A *sustained oscillation* is a march
+that settled in a bounded, stationary motion of any class: periodic (``kind`` "lco", a limit
+cycle), "quasi-periodic" or "chaotic" (:data:`aeroservo.simulate.lco_detect.SUSTAINED`); the
+onset and the summary's ranges count all three, each class named. Figures: :mod:`.plots`.
 """
 
 from __future__ import annotations
@@ -10,8 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from ...result_shape import Result
+from ...simulate.lco_detect import SUSTAINED
 
-__all__ = ["LCOResult", "TABLE_COLUMNS", "describing_lines"]
+__all__ = ["LCOResult", "TABLE_COLUMNS", "NOT_SETTLED", "describing_lines", "class_ranges"]
+
+NOT_SETTLED = ("unsettled", "undecided", "failed")
+"""Verdicts of marches that settled in nothing the study can name."""
 
 TABLE_COLUMNS = (
     "start",
@@ -20,6 +27,7 @@ TABLE_COLUMNS = (
     "kind",
     "confidence",
     "frequency",
+    "modulation",
     "amplitude",
     "rms",
     "mean",
@@ -29,7 +37,9 @@ TABLE_COLUMNS = (
     "switches_per_second",
     "reason",
 )
-"""Columns of :attr:`LCOResult.table` (SI: m/s, rad, Hz, 1/s)."""
+"""Columns of :attr:`LCOResult.table` (SI: m/s, rad, Hz, 1/s). ``frequency`` is the
+fundamental of a limit cycle, the strongest line of the spectrum of a quasi-periodic or chaotic
+oscillation; ``modulation`` the frequency of a quasi-periodic one's modulation."""
 
 
 class LCOResult(Result):
@@ -44,10 +54,11 @@ class LCOResult(Result):
     rows : list of dict
         One per march: ``start`` ("point", "up" or "down"), ``speed`` [m/s], ``initial``
         rotation [rad] (nan for a sweep's march that starts from the state carried on),
-        ``kind`` (lco, decay, growing, divergence, aperiodic, undecided, failed),
-        ``confidence``, ``reason``, ``frequency`` [Hz], ``amplitude`` and ``rms`` [rad] of the
-        reference rotation, per gap, ``peaks``/``rmss`` of every recorded signal, and
-        ``history`` (the end of the march).
+        ``kind`` (sustained: lco (periodic), quasi-periodic, chaotic; otherwise decay, growing,
+        divergence, unsettled, undecided, failed), ``confidence``, ``reason``, ``frequency``
+        and ``modulation`` [Hz], ``amplitude`` and ``rms`` [rad] of the reference rotation, per
+        gap, ``peaks``/``rmss`` of every recorded signal, and ``history`` (the end of the
+        march).
     settings : dict
         What was run (elements, laws, speeds, amplitudes, duration, controller, timing, notes).
     branches : DescribingBranches or None
@@ -107,12 +118,18 @@ class LCOResult(Result):
         return ("bifurcation", "histories") if has else ("bifurcation",)
 
     def lco_rows(self) -> list[dict]:
-        """The marches that settled in a limit cycle."""
+        """The marches that settled in a limit cycle (periodic)."""
         return [r for r in self.rows if r["kind"] == "lco"]
 
-    def onset(self) -> float:
-        """Lowest speed [m/s] where any march settled in a limit cycle (nan if none)."""
-        v = [r["speed"] for r in self.lco_rows()]
+    def sustained_rows(self) -> list[dict]:
+        """The marches that settled in a sustained oscillation of any class (periodic,
+        quasi-periodic, chaotic)."""
+        return [r for r in self.rows if r["kind"] in SUSTAINED]
+
+    def onset(self, kinds=tuple(SUSTAINED)) -> float:
+        """Lowest speed [m/s] where any march settled in a sustained oscillation of one of
+        ``kinds`` (default every class; ``("lco",)``: periodic ones only); nan if none."""
+        v = [r["speed"] for r in self.rows if r["kind"] in kinds]
         return float(min(v)) if v else float("nan")
 
     def diverged_from(self) -> float:
@@ -122,17 +139,19 @@ class LCOResult(Result):
 
     def hysteresis(self) -> list[float]:
         """Speeds [m/s] where the up and down sweeps end in different states (different
-        verdicts, or limit cycles whose amplitudes differ by more than 5 %)."""
+        verdicts, or limit cycles whose amplitudes, irregular oscillations whose RMS, differ
+        by more than 5 %)."""
         up = {r["speed"]: r for r in self.rows if r["start"] == "up"}
         down = {r["speed"]: r for r in self.rows if r["start"] == "down"}
         out = []
         for v in sorted(set(up) & set(down)):
             a, b = up[v], down[v]
+            # a limit cycle by its amplitude, an irregular oscillation by its RMS (its peaks
+            # are those of single excursions)
+            size = "amplitude" if a["kind"] == "lco" else "rms"
             if a["kind"] != b["kind"]:
                 out.append(v)
-            elif a["kind"] == "lco" and abs(a["amplitude"] - b["amplitude"]) > 0.05 * max(
-                a["amplitude"], b["amplitude"]
-            ):
+            elif a["kind"] in SUSTAINED and abs(a[size] - b[size]) > 0.05 * max(a[size], b[size]):
                 out.append(v)
         return out
 
@@ -152,19 +171,31 @@ class LCOResult(Result):
             f"({s.get('controller', '')}), elements {', '.join(s.get('elements', []))}: "
             f"{'; '.join(s.get('laws', []))}",
         ]
-        lcos = self.lco_rows()
-        if lcos:
-            v = [r["speed"] for r in lcos]
-            amp = [r["amplitude_per_gap"] if gap else r["amplitude"] for r in lcos]
-            unit = "x gap" if gap else "rad"
+        ranges = class_ranges(self)
+        if ranges:
+            k, unit = (1.0 / gap, "x gap") if gap else (1.0, "rad")
+            speeds = [self.onset(), max(r["speed"] for r in self.sustained_rows())]
             lines.append(
-                f"limit cycles from {min(v):.4g} to {max(v):.4g} m/s, amplitude (half peak-to-"
-                f"peak of {s.get('reference')}) {min(amp):.3g} to {max(amp):.3g} {unit}, "
-                f"{min(r['frequency'] for r in lcos):.3g} to "
-                f"{max(r['frequency'] for r in lcos):.3g} Hz"
+                f"sustained oscillations {_span(speeds, '.4g', 'from')} m/s (half peak-to-peak "
+                f"and RMS of {s.get('reference')}):"
             )
+            for name, c in ranges.items():
+                lines.append(
+                    f"  {name} at {_speeds_text(c['speeds'])} m/s: amplitude "
+                    f"{_span(c['amplitude_range'], '.3g', scale=k)} {unit}, RMS "
+                    f"{_span(c['rms_range'], '.3g', scale=k)} {unit}, "
+                    f"{_span(c['frequency_range'], '.3g')} Hz"
+                    + ("" if name == "periodic" else " (the spectrum's strongest line)")
+                    + (
+                        f", modulated at {_span(c['modulation_range'], '.3g')} Hz"
+                        if c["modulation_range"]
+                        else ""
+                    )
+                )
         else:
-            lines.append("no settled limit cycle at any speed")
+            lines.append(
+                "no sustained oscillation (periodic, quasi-periodic or chaotic) at any speed"
+            )
         dv = self.diverged_from()
         if np.isfinite(dv):
             lines.append(f"divergent motion from {dv:.4g} m/s")
@@ -182,10 +213,10 @@ class LCOResult(Result):
                 + ", ".join(f"{v:.4g}" for v in hyst)
                 + " m/s"
             )
-        other = [r for r in self.rows if r["kind"] in ("aperiodic", "undecided", "failed")]
+        other = [r for r in self.rows if r["kind"] in NOT_SETTLED]
         if other:
             lines.append(
-                f"{len(other)} marches not settled (aperiodic, undecided or failed): see the "
+                f"{len(other)} marches not settled ({', '.join(NOT_SETTLED)}): see the "
                 "table's reason column"
             )
         lines += describing_lines(self)
@@ -223,14 +254,14 @@ def describing_lines(result) -> list[str]:
         f"{b.speed[seen].min():.4g} to {b.speed[seen].max():.4g} m/s, "
         f"{b.frequency[seen].min():.3g}-{b.frequency[seen].max():.3g} Hz"
     ]
-    onset = result.onset()
+    onset = result.onset(("lco",))  # a describing function predicts periodic motion
     marched = min(r["speed"] for r in result.rows)
     early = b.speed[seen & (b.speed >= marched)]  # within the marched speeds only
     if np.isfinite(onset) and early.size and early.min() < 0.9 * onset:
         lines.append(
-            f"  it predicts limit cycles below {onset:.4g} m/s, where no march settles in one "
-            f"(down to {early.min():.4g} m/s): near the gap edges the motion is far from the "
-            "one harmonic it keeps"
+            f"  it predicts limit cycles below {onset:.4g} m/s, where no march settles in a "
+            f"periodic one (down to {early.min():.4g} m/s): near the gap edges the motion is "
+            "far from the one harmonic it keeps"
         )
     errs = []
     for r in result.lco_rows():
@@ -275,3 +306,38 @@ def _branch_at(b, seen, speed: float, freq: float):
                 ):
                     best = (a, f)
     return best
+
+
+def class_ranges(result) -> dict:
+    """Per class of sustained oscillation (``"periodic"``, ``"quasi-periodic"``,
+    ``"chaotic"``, in that order, those present): its ``speeds`` [m/s] and the ranges
+    ``[min, max]`` of ``amplitude`` and ``rms`` [rad], ``frequency`` and ``modulation`` [Hz]
+    (``None`` where no march has one) over its marches."""
+    out = {}
+    for kind, name in SUSTAINED.items():
+        rows = [r for r in result.rows if r["kind"] == kind]
+        if not rows:
+            continue
+        out[name] = {"speeds": sorted({r["speed"] for r in rows})}
+        for key in ("amplitude", "rms", "frequency", "modulation"):
+            v = [r[key] for r in rows if np.isfinite(r.get(key, np.nan))]
+            out[name][f"{key}_range"] = [min(v), max(v)] if v else None
+    return out
+
+
+def _speeds_text(speeds) -> str:
+    """``4, 5, 6`` or ``4 to 9 (6 speeds)``."""
+    if len(speeds) <= 4:
+        return ", ".join(f"{v:.4g}" for v in speeds)
+    return f"{speeds[0]:.4g} to {speeds[-1]:.4g} ({len(speeds)} speeds)"
+
+
+def _span(v, fmt: str, lead: str = "", scale: float = 1.0) -> str:
+    """``lo to hi`` (with ``lead`` before: ``from lo to hi``), or the one value when they are
+    equal (``at v``); ``?`` for ``None``."""
+    if not v:
+        return "?"
+    lo, hi = (format(x * scale, fmt) for x in v)
+    if lo == hi:
+        return f"at {lo}" if lead else lo
+    return f"{lead} {lo} to {hi}" if lead else f"{lo} to {hi}"

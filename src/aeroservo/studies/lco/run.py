@@ -10,7 +10,7 @@ import numpy as np
 
 from ...errors import InputError, check_int
 from .result import LCOResult
-from .study import LCOSetup, LCOSweep, march_task
+from .study import LCOSetup, LCOSweep, march_task, plausibility_notes
 
 __all__ = ["run_lco"]
 
@@ -74,7 +74,7 @@ def run_lco(
                 timeout=timeout, bar=bar, what=f"lco-{setup.name}",
             )  # fmt: skip
     rows = [r for rs in done for r in rs]
-    notes = []
+    notes = plausibility_notes(setup, sweep.extra.get("hinges_source", "hinges"))
     branches = None
     if describing:
         branches, note = _describing(setup, sweep)

@@ -193,11 +193,15 @@ def _plain(v: object) -> object:
 
 
 def lco_summary(result, scenario: Scenario | None = None) -> dict:
-    """The JSON-ready summary of a limit-cycle result: where limit cycles settle (speeds,
-    amplitudes and frequencies of the reference rotation, SI units and radians), where the
-    motion diverges, the hysteresis of the sweeps, the notes and the study's settings."""
+    """The JSON-ready summary of a limit-cycle result: where sustained oscillations settle
+    (``lco_onset``, ``lco_speeds`` and the ranges of the amplitudes and frequencies of the
+    reference rotation, over every class; ``lco_classes``: the same per class, periodic,
+    quasi-periodic and chaotic; SI units and radians), where the motion diverges, the hysteresis
+    of the sweeps, the notes and the study's settings."""
+    from .result import class_ranges
+
     s = result.settings
-    lcos = result.lco_rows()
+    lcos = result.sustained_rows()
     counts: dict = {}
     for r in result.rows:
         counts[r["kind"]] = counts.get(r["kind"], 0) + 1
@@ -224,6 +228,7 @@ def lco_summary(result, scenario: Scenario | None = None) -> dict:
         ]
         if lcos
         else None,
+        "lco_classes": class_ranges(result),
         "diverged_from": _plain(result.diverged_from()),
         "hysteresis_speeds": result.hysteresis(),
         "marches": len(result.rows),
@@ -233,7 +238,8 @@ def lco_summary(result, scenario: Scenario | None = None) -> dict:
         "units": {
             "speed": "m/s",
             "amplitude": "rad (half peak-to-peak of the reference rotation)",
-            "frequency": "Hz",
+            "frequency": "Hz (of a limit cycle its fundamental; of a quasi-periodic or chaotic "
+            "oscillation the strongest line of its spectrum)",
             "gap": "rad (total)",
             "density": "kg/m^3",
         },

@@ -29,11 +29,17 @@ from ...system.hinge_elements import NonlinearHinge, hinge_elements
 
 __all__ = [
     "LCOSetup", "LCOSweep", "march_task", "study_steps", "HISTORY_SAMPLES", "MAX_STUDY_STEPS",
+    "plausibility_notes",
 ]  # fmt: skip
 
 DIVERGED = 10.0
 """A growing march is called divergent once its reference rotation exceeds this many gaps
 (below: "growing", not settled within the march)."""
+
+ABSURD = 1e3
+"""A march whose reference rotation reaches this many gaps (or a non-finite value) diverges,
+whatever its verdict (a freeplay march above the gap-closed flutter speed grows without bound:
+1e303 gaps in 30 s at 50 m/s on the Conner section)."""
 
 HISTORY_SAMPLES = 4000
 """Samples kept of each march's last ``history`` seconds (for the example time histories)."""
@@ -158,6 +164,12 @@ class LCOSweep:
         largest).
     history : float
         Seconds kept of the end of each march for example time histories.
+    extra : dict
+        Settings carried into the result (a scenario's name, source, ...). With
+        ``"open_loop_flutter_speed"`` [m/s] (the flutter speed with every spring closed; a
+        scenario sets it), a march of the open loop with piecewise-linear laws that still grows
+        at or above it is a divergence, not "growing": beyond the gaps the springs are linear
+        and unstable there.
     """
 
     speeds: Sequence[float]
@@ -247,8 +259,24 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
     hist |= {k: v[keep][::step] for k, v in signals.items()}
     gap = setup.gap
     kind_, reason = verdict.kind, verdict.reason
-    reach = float(np.max(np.abs(res.rotations[setup.reference] - _centre(setup))))
-    if kind_ == "divergence" and gap and np.isfinite(reach) and reach < DIVERGED * gap:
+    with np.errstate(over="ignore", invalid="ignore"):
+        reach = float(np.max(np.abs(res.rotations[setup.reference] - _centre(setup))))
+    if gap and not reach <= ABSURD * gap and kind_ != "divergence":  # nan fails the test too
+        kind_ = "divergence"
+        why = f"divergence: the rotation reaches {reach / gap:.3g} x gap (> {ABSURD:g})"
+        reason = f"{why}; {reason}"
+    vf = sweep.extra.get("open_loop_flutter_speed")
+    unbounded = (  # open loop, piecewise-linear laws: beyond the gaps the springs are linear
+        vf is not None and setup.controller is None and setup.elements.piecewise_linear
+        and speed >= vf
+    )  # fmt: skip
+    moderate = kind_ == "divergence" and gap and np.isfinite(reach) and reach < DIVERGED * gap
+    if moderate and unbounded:
+        reason = (
+            f"divergence at or above the flutter speed with every spring closed ({vf:.4g} m/s), "
+            f"which no gap bounds (largest rotation {reach / gap:.3g} x gap); {reason}"
+        )
+    elif moderate:
         kind_ = "growing"  # not settled at the end of the march, and still moderate
         if reach < 0.5 * gap:
             what = f"unstable inside the gap: grows, largest rotation {reach / gap:.3g} x gap"
@@ -271,6 +299,7 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
         "confidence": verdict.confidence,
         "reason": reason,
         "frequency": float(verdict.frequency),
+        "modulation": float(verdict.modulation),
         "amplitude": float(verdict.peak[ref]),
         "rms": float(verdict.rms[ref]),
         "mean": float(verdict.mean[ref]),
@@ -304,6 +333,7 @@ def _failed(kind, speed, amp, reason, verdict: str = "failed") -> dict:
         "confidence": "high",
         "reason": reason,
         "frequency": float("nan"),
+        "modulation": float("nan"),
         "amplitude": float("nan"),
         "rms": float("nan"),
         "mean": float("nan"),
@@ -316,3 +346,53 @@ def _failed(kind, speed, amp, reason, verdict: str = "failed") -> dict:
         "saturated": {},
         "history": {},
     }
+
+
+PLAUSIBLE_EDGE = 0.1
+"""Largest rotation [rad] (5.7 deg) of a gap's edge from the neutral position, or of a cubic
+law's own scale, before the run warns: a freeplay limit cycle swings the surface about one
+total gap (half peak-to-peak 0.9 to 1 gap on the Conner section), so a 0.2 rad gap centred at
+zero (edges at +-5.7 deg) already swings it +-11 deg, about where a plain flap's lift stops
+growing linearly with its deflection; the linear (attached-flow) aerodynamics of these models
+know nothing of that. The gap of Conner et al. is 0.074 rad (edges at +-2.1 deg)."""
+
+
+def plausibility_notes(setup: LCOSetup, where: str = "hinges") -> list[str]:
+    """Warnings (not refusals) for hinge laws whose motion lies beyond what linear
+    aerodynamics describe: a gap whose farther edge lies more than :data:`PLAUSIBLE_EDGE` from
+    zero, a cubic law whose cubic term equals its linear one only beyond it. ``where`` names
+    the hinge tables (``"lco.hinges"``, or a wing file's ``[[hinges]]``)."""
+    notes = []
+    where = where.replace(" [[hinges]]", ": hinges")  # a wing file's tables
+    for i, h in enumerate(setup.hinges):
+        law = h.law
+        gap = getattr(law, "gap", None)
+        if gap:
+            offset = float(getattr(law, "offset", 0.0))
+            edge = abs(offset) + 0.5 * gap
+            if edge <= PLAUSIBLE_EDGE:
+                continue
+            key, value = ("gap", gap) if 0.5 * gap > PLAUSIBLE_EDGE else ("offset", offset)
+            notes.append(
+                f"warning: {where}[{i}].{key} = {value:g} rad: the gap's edge lies "
+                f"{np.degrees(edge):.3g} deg from zero and its limit cycles swing {h.target!r} "
+                f"by about one gap ({np.degrees(gap):.3g} deg), beyond the "
+                f"{np.degrees(PLAUSIBLE_EDGE):.2g} deg within which the linear aerodynamics of "
+                "this model hold: its amplitudes and onsets are the model's, not a wing's"
+            )
+            continue
+        c = getattr(law, "coefficient", None)
+        ks = [k for k, el_law in zip(setup.elements.stiffness, setup.elements.laws, strict=True)
+              if el_law is law]  # fmt: skip
+        if not c or not ks:
+            continue
+        scale = float(np.sqrt(min(abs(k) for k in ks) / abs(c)))
+        if scale > PLAUSIBLE_EDGE:
+            notes.append(
+                f"warning: {where}[{i}].coefficient = {c:g} N m/rad^3: its cubic term equals the "
+                f"linear one only at {scale:.3g} rad ({np.degrees(scale):.3g} deg) of "
+                f"{h.target!r}, beyond the {np.degrees(PLAUSIBLE_EDGE):.2g} deg within which the "
+                "linear aerodynamics of this model hold: the motion it shapes is the model's, not "
+                "a wing's"
+            )
+    return notes
