@@ -425,7 +425,9 @@ def test_lco_against_the_measured_rms(damped_study):
     assert np.all(freq_up[(ratio > 0.36) & (ratio < 0.5)] < 6.0)
     for v in speeds[ratio < 0.5]:
         r = rows["down"][v]
-        assert r["kind"] in ("lco", "aperiodic") and 4.5 < r["frequency"] < 5.5, r
+        # a limit cycle, or near 0.44 U_F a biased one modulated at 1.5 Hz (issue 40: not
+        # 'aperiodic', a sustained quasi-periodic oscillation reported at its 4.9 Hz carrier)
+        assert r["kind"] in ("lco", "quasi-periodic") and 4.5 < r["frequency"] < 5.5, r
     assert rows["down"][speeds[0]]["kind"] == "lco"
     assert np.all(np.abs(err[ratio < 0.5]) <= 0.40), err
     pitch = np.array([rows["down"][v]["rmss"]["pitch"] / GAP for v in speeds])

@@ -9,8 +9,9 @@ import time
 import numpy as np
 
 from ...errors import InputError, check_int
+from .plausibility import plausibility_notes
 from .result import LCOResult
-from .study import LCOSetup, LCOSweep, march_task, plausibility_notes
+from .study import LCOSetup, LCOSweep, march_task
 
 __all__ = ["run_lco"]
 
