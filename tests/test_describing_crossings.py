@@ -140,8 +140,8 @@ def test_agreeing_intervals_are_the_count_alone():
 def test_stop_notes_name_a_flat_branch():
     """A branch whose speed moved by more than 5 % over its last step and that stops before the
     last amplitude: one note; one that moves little or reaches the last amplitude: none; two of
-    one frequency that stop together, their speeds converging (a fold in amplitude): none; one
-    whose extrapolated speed is off the grid: it leaves the grid."""
+    one frequency that stop together, their speeds converging (a fold in amplitude, flat or
+    not): none; one whose extrapolated speed is off the grid: none (a note on a wider grid)."""
 
     class P:
         def __init__(self, speed, frequency):
@@ -157,15 +157,19 @@ def test_stop_notes_name_a_flat_branch():
         [],
     ]
     ids = [[0, 1, 2, 3, 4], [0, 1, 2, 3, 4], [0, 1, 2, 3, 4], [1], []]
+    for row, bs, vs in zip(
+        points[:3], ids[:3], [(100.0, 121.0), (106.0, 120.0), (114.0, 119.0)], strict=True
+    ):
+        row += [P(vs[0], 12.0), P(vs[1], 12.2)]  # a flat branch folding with a steep one
+        bs += [5, 6]
     notes = stop_notes(amps, points, ids, np.linspace(100.0, 160.0, 9), gap)
     assert notes == [
-        "branch 0 (26.3 Hz) stops at 0.65 gap, 156.9 m/s: leaves the speed grid [100, 160] m/s "
-        "(its speed changed by +9.6 m/s from 0.64 gap; extrapolated to 166.5 m/s at 0.66 gap, "
-        "where it is not found): extend the speeds",
         "branch 4 (40 Hz) stops at 0.65 gap, 130 m/s: flat (its speed changed by -15 m/s from "
         "0.64 gap; extrapolated to 115 m/s at 0.66 gap, where it is not found): refine the "
-        "amplitudes between 0.65 gap and 0.66 gap",
+        "amplitudes between 0.65 gap and 0.66 gap"
     ]
+    wider = stop_notes(amps, points, ids, np.linspace(100.0, 170.0, 9), gap)
+    assert len(wider) == 2 and wider[0].startswith("branch 0 (26.3 Hz) stops at 0.65 gap, 156.9")
 
 
 # 2-3. The Goland LQR loop ------------------------------------------------------------------

@@ -15,8 +15,8 @@ reported. A single root that crosses and crosses back within one interval is sti
 A branch continued in amplitude (the crossings at successive amplitudes) stops where the next
 amplitude has no crossing like it. On a *flat* branch (the limit-cycle amplitude almost
 constant over a range of speeds: the crossing speed changes fast with amplitude), one step in
-amplitude moves the crossing further than the amplitudes resolve, or off the speed grid;
-:func:`stop_notes` names the amplitude and speed where such a branch stops and why.
+amplitude moves the crossing further than the amplitudes resolve; :func:`stop_notes` names
+the amplitude and speed where such a branch stops and why.
 """
 
 from __future__ import annotations
@@ -132,11 +132,12 @@ def stop_notes(amps, points: list, ids: list, speeds: np.ndarray, gap: float | N
     -------
     list of str
         One note per branch that stops at an amplitude ``A_k`` (not the last) after its speed
-        changed by more than :data:`FLAT` over the step ``A_(k-1) -> A_k``: where it stops,
-        its speed extrapolated to ``A_(k+1)``, and what to do: refine the amplitudes, or extend
-        the speeds if that speed is off the grid. Two such branches of one frequency (within
-        10 %) stopping at the same amplitude whose extrapolated speeds cross meet in a fold in
-        amplitude (no limit cycle of a larger amplitude there): no note.
+        changed by more than :data:`FLAT` over the step ``A_(k-1) -> A_k`` and whose speed
+        extrapolated to ``A_(k+1)`` is on the grid: where it stops, that speed, and the
+        amplitudes to refine. None for a branch extrapolated off the grid (it leaves the
+        speeds searched, as drawn), nor for one that meets another branch of its frequency
+        (within 10 %) stopping at the same amplitude, their extrapolated speeds crossing: a
+        fold in amplitude (no limit cycle of a larger amplitude there).
     """
 
     def amp(a: float) -> str:
@@ -146,37 +147,35 @@ def stop_notes(amps, points: list, ids: list, speeds: np.ndarray, gap: float | N
     for k, (row, bs) in enumerate(zip(points, ids, strict=True)):
         for p, b in zip(row, bs, strict=True):
             hist.setdefault(b, []).append((k, p))
-    stops = []  # (branch, k, point, speed change, extrapolated speed, previous amplitude)
+    ends = []  # every branch that stops early: (branch, k, point, change, ahead, previous A)
     for b, h in sorted(hist.items()):
-        if len(h) < 2 or h[-1][0] == len(amps) - 1:
+        k1, p1 = h[-1]
+        if k1 == len(amps) - 1:
             continue
-        (k0, p0), (k1, p1) = h[-2:]
-        dv = p1.speed - p0.speed
-        if abs(dv) > FLAT * p1.speed:
+        dv, ahead, a0 = 0.0, p1.speed, amps[k1]
+        if len(h) > 1:
+            k0, p0 = h[-2]
+            dv, a0 = p1.speed - p0.speed, amps[k0]
             ahead = p1.speed + dv * (amps[k1 + 1] - amps[k1]) / (amps[k1] - amps[k0])
-            stops.append((b, k1, p1, dv, ahead, amps[k0]))
+        ends.append((b, k1, p1, dv, ahead, a0))
     fold = {
         s[0]
-        for s in stops
-        for t in stops
+        for s in ends
+        for t in ends
         if s is not t
         and s[1] == t[1]
         and abs(s[2].frequency - t[2].frequency) <= 0.1 * s[2].frequency
         and (s[2].speed - t[2].speed) * (s[4] - t[4]) < 0
     }
+    stops = [e for e in ends if abs(e[3]) > FLAT * e[2].speed]
     notes = []
     for b, k1, p1, dv, ahead, a0 in stops:
-        if b in fold:
-            continue
-        grid = f"[{speeds[0]:.4g}, {speeds[-1]:.4g}] m/s"
-        why, fix = (
-            (f"leaves the speed grid {grid}", "extend the speeds")
-            if not speeds[0] <= ahead <= speeds[-1]
-            else ("flat", f"refine the amplitudes between {amp(amps[k1])} and {amp(amps[k1 + 1])}")
-        )
+        if b in fold or not speeds[0] <= ahead <= speeds[-1]:
+            continue  # a fold, or it leaves the speed grid (as drawn)
         notes.append(
             f"branch {b} ({p1.frequency:.4g} Hz) stops at {amp(amps[k1])}, {p1.speed:.5g} m/s: "
-            f"{why} (its speed changed by {dv:+.3g} m/s from {amp(a0)}; extrapolated to "
-            f"{ahead:.4g} m/s at {amp(amps[k1 + 1])}, where it is not found): {fix}"
+            f"flat (its speed changed by {dv:+.3g} m/s from {amp(a0)}; extrapolated to "
+            f"{ahead:.4g} m/s at {amp(amps[k1 + 1])}, where it is not found): refine the "
+            f"amplitudes between {amp(amps[k1])} and {amp(amps[k1 + 1])}"
         )
     return notes
