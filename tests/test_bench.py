@@ -21,7 +21,7 @@ BENCH = Path(__file__).resolve().parents[1] / "bench"
         ("bench_mpc_step.py", 1),
         ("bench_trade.py", 1),
         ("bench_gust_loads.py", 5),
-        ("bench_lco.py", 3),
+        ("bench_lco.py", 5),
         ("bench_dlm.py", 3),
     ],
 )

@@ -15,8 +15,10 @@ open loop's, on the growth rates ``ln|mu| / dt`` [1/s] of the sampled loop:
 
 * **Crossings.** The rates of every root on the speed grid, sorted in descending order, are
   continuous in speed (rank 0: the spectral radius). Where the number of growing roots changes
-  between grid speeds, Brent's method finds the sign change of each rank in between. Two roots
-  crossing in opposite directions within one grid interval are missed (refine ``speeds``). With
+  between grid speeds, Brent's method finds the sign change of each rank in between; where two
+  roots cross in opposite directions within one grid interval (the roots paired by continuity
+  change sign more often than the count), the interval is bisected until they separate, or a
+  note says so (:mod:`aeroservo.stability.describing_checks`). With
   a zero command ``M = expm(A dt)``, whose rates are the real parts of the continuous roots: the
   open-loop describing function. A real ``mu`` (static at +1, or the two-sample oscillation at
   -1) is not a first-harmonic limit cycle and is left out.
@@ -44,6 +46,7 @@ from .._threads import blas_limited
 from ..errors import InputError, check_number
 from ..linear.hinge_plant import hinge_inputs
 from ..stability.brent import RTOL_MIN, BracketError, brentq
+from ..stability.describing_checks import hidden_note, search_intervals, stop_notes
 from ..stability.describing_function import (
     MATCH,
     STEP,
@@ -181,23 +184,33 @@ def _position(labels: list, name: str, what: str) -> int:
 
 
 def crossings(
-    eq: EquivalentLoop, dk: np.ndarray, speeds, tol: float, keep: bool = True
+    eq: EquivalentLoop, dk: np.ndarray, speeds, tol: float, keep: bool = True, notes=None
 ) -> list[Crossing]:
     """Every oscillatory crossing of the unit circle on a speed grid (module docstring);
-    ``keep``: cache the plant at the grid speeds."""
+    ``keep``: cache the plant at the grid speeds; ``notes`` (a list) receives a note per grid
+    interval where two roots cross and bisection could not separate them."""
     speeds = np.asarray(speeds, dtype=float)
-    n_pos = (eq.rates(eq.matrices(speeds, dk, keep)) > 0).sum(axis=1)
+
+    def growing(w: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore"):
+            return np.log(np.abs(w)) / eq.dt > 0
 
     def rank(v: float, j: int) -> float:
         return float(eq.rates(eq.matrices([v], dk))[0, j])
 
+    w = np.linalg.eigvals(eq.matrices(speeds, dk, keep))
+    found, lost = search_intervals(
+        speeds, w, growing, lambda v: np.linalg.eigvals(eq.matrices([v], dk)[0])
+    )
+    if notes is not None:
+        notes.extend(hidden_note(a, b) for a, b in lost)
     out: list[Crossing] = []
-    for i in np.flatnonzero(np.diff(n_pos)).tolist():
-        lo, hi = sorted((int(n_pos[i]), int(n_pos[i + 1])))
+    for va, vb, na, nb in found:
+        lo, hi = sorted((na, nb))
         j = lo
         while j < hi:
             try:
-                v = brentq(rank, speeds[i], speeds[i + 1], (j,), tol * speeds[i + 1], RTOL_MIN)
+                v = brentq(rank, va, vb, (j,), tol * vb, RTOL_MIN)
             except BracketError:  # a rate at rounding level at a grid speed
                 j += 1
                 continue
@@ -364,11 +377,16 @@ def loop_describing_branches(
     check_centred(eq.elements)
     ones = np.ones(eq.elements.n)
     points: list[list[_Point]] = []
+    notes: list[str] = []
     for a in amps:
         row: list[_Point] = []
-        for start in crossings(eq, eq.dk(a, ones), grid, tol):
+        hidden: list[str] = []
+        for start in crossings(eq, eq.dk(a, ones), grid, tol, notes=hidden):
             hit = converge(eq, a, grid, tol, start)
             if hit is not None and all(abs(hit[0] - p.speed) > 1e-6 * hit[0] for p in row):
                 row.append(_point(eq, a, *hit, tol))
         points.append(row)
-    return branches_from_points(amps, points, _branch_ids(points), eq.elements)
+        notes += [f"amplitude {a:.6g} rad: {n}" for n in hidden]
+    ids = _branch_ids(points)
+    notes += stop_notes(amps, points, ids, grid, getattr(eq.elements.laws[0], "gap", None))
+    return branches_from_points(amps, points, ids, eq.elements, notes)

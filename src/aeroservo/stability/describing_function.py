@@ -22,7 +22,11 @@ Method, per amplitude:
   (relative). No eigenvalue matching is needed, and several roots crossing at different speeds
   are each found. A real root crossing zero (static divergence of the equivalent system) is
   not an LCO and is left out, as is a crossing of a mode the elements do not move.
-  A root that crosses and crosses back within one grid interval is missed (refine ``speeds``).
+  Two roots crossing in opposite directions within one grid interval leave ``m`` unchanged:
+  the roots at its ends are paired by continuity and, where their own sign changes disagree
+  with ``m``, the interval is bisected (:mod:`.describing_checks`; a note if that does not
+  separate them). A root that crosses and crosses back within one interval is missed (refine
+  ``speeds``).
 * **Several elements.** The amplitude ratios ``a_j / A`` are those of the neutral eigenvector,
   ``|C_n v|`` over its reference entry; starting from 1 they are iterated (the crossing found
   again near the last one with the new ratios) until they change by less than
@@ -51,6 +55,7 @@ from .._threads import blas_limited
 from ..errors import InputError, check_number
 from ..system.first_order import FirstOrderSystem
 from ..system.hinge_elements import HingeElements
+from .describing_checks import stop_notes
 from .equivalent_system import EquivalentSystem, converge, crossings, growth
 
 __all__ = ["DescribingBranches", "describing_branches", "STEP"]
@@ -87,6 +92,9 @@ class DescribingBranches:
     others_stable : ndarray (n_pts,) bool
         Every other root of the equivalent system is damped at that point (if not, the LCO is
         not observed even where ``stable``: another oscillation grows).
+    notes : tuple of str
+        What the grids did not resolve (:mod:`.describing_checks`): two roots crossing within
+        one speed interval that bisection could not separate, a flat branch that stops.
     """
 
     amplitude: np.ndarray
@@ -99,6 +107,7 @@ class DescribingBranches:
     element: str
     names: tuple[str, ...] = ()
     others_stable: np.ndarray | None = None
+    notes: tuple[str, ...] = ()
 
     @classmethod
     def from_table(
@@ -229,14 +238,19 @@ def describing_branches(
     grid = _default_speeds(eq, system) if speeds is None else _check_speeds(speeds)
     ones = np.ones(elements.n)
     points: list[list[_Point]] = []
+    notes: list[str] = []
     for a in amps:
         row: list[_Point] = []
-        for start in crossings(eq, eq.base(a, ones), grid, tol):
+        hidden: list[str] = []
+        for start in crossings(eq, eq.base(a, ones), grid, tol, hidden):
             hit = converge(eq, a, grid, tol, start, elements.names)
             if hit is not None and all(abs(hit[0] - p.speed) > 1e-6 * hit[0] for p in row):
                 row.append(_point(eq, a, *hit, tol))
         points.append(row)
-    return branches_from_points(amps, points, _branch_ids(points), elements)
+        notes += [f"amplitude {a:.6g} rad: {n}" for n in hidden]
+    ids = _branch_ids(points)
+    notes += stop_notes(amps, points, ids, grid, getattr(elements.laws[0], "gap", None))
+    return branches_from_points(amps, points, ids, elements, notes)
 
 
 class _Point(NamedTuple):
@@ -337,9 +351,9 @@ def check_centred(elements) -> None:
             )
 
 
-def branches_from_points(amps, points: list, ids: list, elements) -> DescribingBranches:
+def branches_from_points(amps, points: list, ids: list, elements, notes=()) -> DescribingBranches:
     """The :class:`DescribingBranches` of the neutral points found at each amplitude
-    (``points[i]``: the points at ``amps[i]``, ``ids[i]``: their branch ids)."""
+    (``points[i]``: the points at ``amps[i]``, ``ids[i]``: their branch ids; ``notes``)."""
     flat = [
         (a, p, b)
         for a, row, bs in zip(amps, points, ids, strict=True)
@@ -361,4 +375,5 @@ def branches_from_points(amps, points: list, ids: list, elements) -> DescribingB
         element=elements.names[0],
         names=tuple(elements.names),
         others_stable=col("others_stable", bool),
+        notes=tuple(notes),
     )

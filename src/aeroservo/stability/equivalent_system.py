@@ -19,6 +19,7 @@ import scipy.linalg as sla
 from ..system.first_order import FirstOrderSystem
 from ..system.hinge_elements import HingeElements
 from .brent import RTOL_MIN, BracketError, brentq
+from .describing_checks import hidden_note, search_intervals
 
 __all__ = ["EquivalentSystem", "crossings", "converge", "growth", "RATIO_TOL", "MAX_ITER"]
 
@@ -77,7 +78,11 @@ class EquivalentSystem:
 
 
 def crossings(
-    eq: EquivalentSystem, base: np.ndarray, speeds: np.ndarray, tol: float
+    eq: EquivalentSystem,
+    base: np.ndarray,
+    speeds: np.ndarray,
+    tol: float,
+    notes: list[str] | None = None,
 ) -> list[tuple[float, complex, np.ndarray]]:
     """Every oscillatory crossing of the imaginary axis on a speed grid.
 
@@ -90,25 +95,35 @@ def crossings(
         Increasing speeds [m/s].
     tol : float
         Relative tolerance on the crossing speeds.
+    notes : list of str, optional
+        Receives a note per grid interval where two roots cross in opposite directions and the
+        bisections of :func:`.describing_checks.search_intervals` could not separate them.
 
     Returns
     -------
     list of (speed, lambda, vector)
         Crossing speed [m/s], the root there (``Im > 0``) [1/s] and its right eigenvector.
     """
-    re = -np.sort(-eq.eigvals(base, speeds).real, axis=1)
-    n_pos = (re > 0).sum(axis=1)
+    speeds = np.asarray(speeds, dtype=float)
+    found, lost = search_intervals(
+        speeds,
+        eq.eigvals(base, speeds),
+        lambda w: w.real > 0,
+        lambda v: np.linalg.eigvals(eq.matrix(base, v)),
+    )
+    if notes is not None:
+        notes.extend(hidden_note(a, b) for a, b in lost)
 
     def rank(v: float, j: int) -> float:
         return float(-np.sort(-np.linalg.eigvals(eq.matrix(base, v)).real)[j])
 
     out = []
-    for i in np.flatnonzero(np.diff(n_pos)).tolist():
-        lo, hi = sorted((int(n_pos[i]), int(n_pos[i + 1])))
+    for va, vb, na, nb in found:
+        lo, hi = sorted((na, nb))
         roots: list[float] = []
         for j in range(lo, hi):
             try:
-                v = brentq(rank, speeds[i], speeds[i + 1], (j,), tol * speeds[i + 1], RTOL_MIN)
+                v = brentq(rank, va, vb, (j,), tol * vb, RTOL_MIN)
             except BracketError:  # a real part at rounding level at a grid speed
                 continue
             if all(abs(v - r) > 10 * tol * v for r in roots):

@@ -11,6 +11,8 @@ rotation ends beyond an edge, or its cubic interpolant comes near one); :func:`q
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = [
@@ -26,6 +28,8 @@ __all__ = [
     "modal_path",
     "modal_at",
     "rotations_at",
+    "rows_at",
+    "scan_rows",
     "state_at",
 ]
 
@@ -64,18 +68,20 @@ def _turns(s0: float, s1: float, r0: float, r1: float) -> int:
     return sum(0.0 < t < 1.0 for t in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)))
 
 
-def exits(s, taus, lo, hi, tol) -> list:
-    """``[(t_a, t_b, element, upper), ...]`` for every element beyond an edge at the first
-    sample (not the first) where any is, or []."""
-    below = s < (lo - tol)[:, None]
-    above = s > (hi + tol)[:, None]
-    out = below | above
+def exits(s, taus, lo_c, hi_c) -> list:
+    """``[(t_a, t_b, element, upper, s_a, s_b), ...]`` for every element beyond an edge at the
+    first sample (not the first) where any is (``s_a, s_b``: its rotations at ``t_a, t_b``),
+    or []; ``lo_c``, ``hi_c``: the edges less and plus their tolerance, as columns."""
+    below = s < lo_c
+    out = below | (s > hi_c)
     out[:, 0] = False
-    cols = np.flatnonzero(out.any(axis=0))
-    if cols.size == 0:
+    if not out.any():
         return []
-    j = int(cols[0])
-    return [(taus[j - 1], taus[j], int(e), not below[e, j]) for e in np.flatnonzero(out[:, j])]
+    j = int(np.flatnonzero(out.any(axis=0))[0])
+    return [
+        (taus[j - 1], taus[j], int(e), not below[e, j], s[e, j - 1], s[e, j])
+        for e in np.flatnonzero(out[:, j])
+    ]
 
 
 def quick_bracket(v0: list, v1: list, rest: float, lo: list, hi: list):
@@ -108,15 +114,15 @@ def crossing_time(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
     if _far_from_zero(lam):
         off = gam / lam
         wa = w * (y0 + off)
-        wl = wa * lam
+        wl = np.array([wa, wa * lam])  # the rotation and its rate in one product
         c0 = float((w @ off).real) + edge
 
         def fs(taus):
             return (wa @ np.exp(np.multiply.outer(lam, taus))).real - c0
 
         def f(tau):
-            ex = np.exp(lam * tau)
-            return float((wa @ ex).real) - c0, float((wl @ ex).real)
+            v, d = (wl @ np.exp(lam * tau)).real.tolist()
+            return v - c0, d
     else:
         wd = w[None, :]
 
@@ -142,7 +148,7 @@ def crossing_time(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
         after = np.flatnonzero(np.sign(vals[inside[0] :]) == np.sign(fb))
         k = inside[0] + int(after[0])
         ta, fa, tb = grid[k - 1], vals[k - 1], grid[k]
-    if np.sign(fa) == np.sign(fb):
+    if _sign(fa) == _sign(fb):
         return ta
     tau = ta + (tb - ta) * fa / (fa - fb)
     span = tb - ta
@@ -150,7 +156,7 @@ def crossing_time(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
         fv, dv = f(tau)
         if fv == 0.0:
             break
-        if np.sign(fv) == np.sign(fa):
+        if _sign(fv) == _sign(fa):
             ta, fa = tau, fv
         else:
             tb = tau
@@ -163,14 +169,19 @@ def crossing_time(w, lam, y0, gam, edge, ta, tb, atol, ends=None) -> float:
     # on to the side beyond the edge (steps doubling from 1e-16 of the bracket): the new
     # region starts on its own side
     fv, dv = f(tau)
-    if np.sign(fv) == np.sign(fb):
+    if _sign(fv) == _sign(fb):
         return tau
-    step = max(2.0 * abs(fv / dv) if dv else 0.0, 8.0 * np.spacing(tau), 1e-18 * span)
-    for _ in range(12):
-        if tau >= tb or np.sign(f(tau)[0]) == np.sign(fb):
+    step = max(2.0 * abs(fv / dv) if dv else 0.0, 8.0 * math.ulp(tau), 1e-18 * span)
+    for k in range(12):  # (at k = 0, tau is the point just evaluated)
+        if tau >= tb or (k and _sign(f(tau)[0]) == _sign(fb)):
             return min(tau, tb)
-        tau, step = max(tau + step, np.nextafter(tau, np.inf)), 2.0 * step
+        tau, step = max(tau + step, math.nextafter(tau, math.inf)), 2.0 * step
     return tb
+
+
+def _sign(x: float) -> float:
+    """``np.sign`` of a Python float, without the call into NumPy."""
+    return 1.0 if x > 0.0 else -1.0 if x < 0.0 else 0.0 if x == 0.0 else x
 
 
 def _phi1(lam: np.ndarray, taus: np.ndarray) -> np.ndarray:
@@ -220,6 +231,38 @@ def rotations_at(W, lam, y0, gam, taus) -> np.ndarray:
     return (W @ modal_path(lam, y0, gam, taus)).real
 
 
+def scan_rows(W, lam, y0, gam, rest: float) -> np.ndarray:
+    """:func:`rows_at` at the :data:`GRID` points of ``[0, rest]``, the exponentials as the
+    powers of ``exp(lambda rest / SUB)`` (four products: the same rows to rounding)."""
+    if lam.size < 16 or not _far_from_zero(lam) or lam.real.max() * rest >= 700.0:
+        return rows_at(W, lam, y0, gam, rest * GRID)  # (few modes: the exponentials are cheap)
+    off = gam / lam
+    ex = np.empty((SUB + 1, lam.size), dtype=complex)  # a row per point: contiguous products
+    ex[0] = 1.0
+    np.exp(lam * (rest / SUB), out=ex[1])
+    n = 1
+    while n < SUB:  # rows n+1 .. 2n from 1 .. n
+        np.multiply(ex[1 : n + 1], ex[n], out=ex[n + 1 : 2 * n + 1])
+        n *= 2
+    return ((W * (y0 + off)) @ ex.T).real - (W @ off).real[:, None]
+
+
+def rows_at(W, lam, y0, gam, taus) -> np.ndarray:
+    """:func:`rotations_at` without the modal coordinates: ``Re(W diag(y0 + gamma/lambda)
+    exp(lambda tau)) - Re(W gamma/lambda)`` when no eigenvalue is near 0 (the same rows to
+    rounding, at the cost of the exponentials alone)."""
+    if not _far_from_zero(lam):
+        return rotations_at(W, lam, y0, gam, taus)
+    off = gam / lam
+    z = np.multiply.outer(lam, taus)
+    if z.real.max() < 700.0:  # no overflow
+        ex = np.exp(z)
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverging march: inf, reported
+            ex = np.exp(z)
+    return ((W * (y0 + off)) @ ex).real - (W @ off).real[:, None]
+
+
 def state_at(V, lam, y0, gam, tau: float) -> np.ndarray:
     """The state ``V y(tau)`` (real) at one time ``tau`` [s]."""
     return (V @ modal_at(lam, y0, gam, tau)).real
@@ -228,6 +271,8 @@ def state_at(V, lam, y0, gam, tau: float) -> np.ndarray:
 def graze_index(s, sd, taus, lo, hi, tol):
     """Index of the first sub-interval whose cubic Hermite interpolant of a rotation (from its
     values and rates at the ends) leaves the piece, or None."""
+    if not (sd[:, :-1] * sd[:, 1:] < 0).any():  # no rate changes sign: no turn
+        return None
     dt = np.diff(taus)
     h00, h10, h01, h11 = _HERMITE
     first = None

@@ -26,13 +26,44 @@ from .exact_motion import (
     exits,
     graze_index,
     modal_at,
-    modal_path,
     quick_bracket,
-    rotations_at,
+    rows_at,
+    scan_rows,
     state_at,
 )
 
-__all__ = ["Regions", "piece_tables"]
+__all__ = ["Regions", "piece_tables", "real_basis"]
+
+
+def real_basis(lam: np.ndarray, V: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The modes kept for a real motion and their weights: ``(keep, weight)``.
+
+    A real matrix's complex roots come in conjugate pairs (LAPACK returns each pair next to
+    each other, the second root and its vector the exact conjugates of the first), and the
+    modal coordinates of a real state are conjugate too, so ``Re(V y) = Re(V[:, keep] weight
+    y[keep])`` with the first root of each pair (weight 2) and every real root (weight 1):
+    about half the modes for the closed-form motion and its crossing search, the same motion
+    to rounding. Without that structure (``keep`` all, weights 1) the full basis is used.
+    """
+    n = lam.size
+    keep, weight, i = [], [], 0
+    while i < n:
+        if lam[i].imag == 0.0:
+            keep.append(i)
+            weight.append(1.0)
+            i += 1
+        elif (
+            i + 1 < n
+            and lam[i].imag > 0.0
+            and lam[i + 1] == np.conj(lam[i])
+            and np.array_equal(V[:, i + 1], np.conj(V[:, i]))
+        ):
+            keep.append(i)
+            weight.append(2.0)
+            i += 2
+        else:
+            return np.arange(n), np.ones(n)
+    return np.array(keep), np.array(weight)
 
 
 def piece_tables(elements) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -112,7 +143,8 @@ class Regions:
 
     def eigen(self, r: tuple):
         """``(lambda, V, V^-1, V^-1 [B g], C_n V, C_rate V, [C_n V; C_rate V])`` of region
-        ``r``."""
+        ``r`` on its real modal basis (:func:`real_basis`: one root of each conjugate pair,
+        its columns of ``V`` doubled; every product with ``V`` is then the real part)."""
         if r not in self._eigen:
             A, g, _, _ = self.system(r)
             lam, V = sla.eig(A)
@@ -126,6 +158,8 @@ class Regions:
                     f"nonlinear march: the linear system of region {r} is defective (eigen-"
                     f"decomposition residual {err:.1e}); it cannot be marched exactly"
                 )
+            keep, weight = real_basis(lam, V)
+            lam, V, Vi = lam[keep], V[:, keep] * weight, Vi[keep]
             G = Vi @ np.hstack([self.B, g[:, None]])
             W, Wd = self.np.c_n @ V, self.np.c_rate @ V
             self._eigen[r] = (lam, V, Vi, G, W, Wd, np.vstack([W, Wd]))
@@ -139,6 +173,8 @@ class Regions:
                 (hi + tol).tolist(),
                 G[:, :-1],
                 G[:, -1],
+                (lo - tol)[:, None],
+                (hi + tol)[:, None],
             )
         return self._eigen[r]
 
@@ -150,20 +186,23 @@ class Regions:
         The interval is scanned at :data:`SUB` points; a sub-interval where a rotation is
         beyond an edge of its piece, or where the cubic Hermite interpolant of the rotation and
         its rate predicts an excursion beyond it (a graze between two points), is scanned
-        finer; the crossing is then located by Brent's method on the closed-form rotation.
+        finer; the crossing is then located by Newton's method (kept in its bracket) on the
+        closed-form rotation.
         """
         t = 0.0
         for _ in range(10_000):
-            lam, V, Vi, G, W, Wd, WWd = self.eigen(r)
-            lo, hi, tol, lo_l, hi_l, Gu, gg = self._edges[r]
+            lam, V, Vi, G, W, Wd, WWd = self._eigen.get(r) or self.eigen(r)
+            lo, hi, tol, lo_l, hi_l, Gu, gg, lo_c, hi_c = self._edges[r]
             y0 = Vi @ x
             gam = Gu @ u + gg if Gu.shape[1] else gg
             rest = h - t
-            y1 = modal_at(lam, y0, gam, rest)
-            v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
             # just after a switch the rotation starts on an edge: scan (a return within the
             # sample would not show at its ends)
-            bracket = quick_bracket(v0, v1, rest, lo_l, hi_l) if t == 0.0 else False
+            bracket = False
+            if t == 0.0:
+                y1 = modal_at(lam, y0, gam, rest)
+                v0, v1 = (WWd @ y0).real.tolist(), (WWd @ y1).real.tolist()
+                bracket = quick_bracket(v0, v1, rest, lo_l, hi_l)
             ends = None
             if bracket is None:  # no edge reached: the end of the interval
                 return (V @ y1).real, r
@@ -172,19 +211,20 @@ class Regions:
                 ends = (v0[bracket[2]], v1[bracket[2]])
             else:  # scan the interval
                 taus = rest * GRID
-                Y = modal_path(lam, y0, gam, taus)
-                s = (W @ Y).real
-                cands = exits(s, taus, lo, hi, tol)
+                rows = scan_rows(WWd, lam, y0, gam, rest)  # rotations, then their rates
+                s = rows[: W.shape[0]]
+                cands = exits(s, taus, lo_c, hi_c)
                 if not cands:
-                    j = graze_index(s, (Wd @ Y).real, taus, lo, hi, tol)
+                    j = graze_index(s, rows[W.shape[0] :], taus, lo, hi, tol)
                     if j is not None:
                         fine = taus[j - 1] + (taus[j] - taus[j - 1]) * FINE
-                        cands = exits(rotations_at(W, lam, y0, gam, fine), fine, lo, hi, tol)
+                        cands = exits(rows_at(W, lam, y0, gam, fine), fine, lo_c, hi_c)
                 if not cands:
-                    return (V @ y1).real, r
+                    return state_at(V, lam, y0, gam, rest), r
             best = None  # the earliest crossing of every element out at the first exit
-            for ta, tb, e, upper in cands:
+            for ta, tb, e, upper, *at_ends in cands:
                 edge = hi[e] if upper else lo[e]
+                ends = at_ends or ends  # the rotations at the bracket's ends, when known
                 tc = crossing_time(W[e], lam, y0, gam, edge, ta, tb, tol[e], ends)
                 if best is None or tc < best[0]:
                     best = (tc, e, upper)

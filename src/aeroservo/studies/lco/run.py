@@ -81,6 +81,8 @@ def run_lco(
         branches, note = _describing(setup, sweep)
         if note:
             notes.append(note)
+        if branches is not None:  # what its grids did not resolve
+            notes += [f"describing function: {n}" for n in branches.notes]
     settings = {
         "name": setup.name,
         "density": setup.density,
