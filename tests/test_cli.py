@@ -198,6 +198,7 @@ FLUTTER_MODULES = {
             ".aeroelastic",
             ".assembly",
             ".damping",
+            ".dof_damping",  # per-DOF viscous damping: part of the damping's definition
             ".first_order",
             ".matrices",
             ".point_masses",

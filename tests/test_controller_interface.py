@@ -1160,7 +1160,9 @@ def test_gain_bounds_and_unknown_states_name_the_file(tmp_path):
     )
     path = scenario_copy(tmp_path / "s", "goland_aileron_hinf", controller=text)
     with pytest.raises(
-        aes.InputError, match=r"brought\.toml: static gain: states \['no_such_state'\]"
+        aes.InputError,
+        match=r"brought\.toml: gain\.states = \['w_3', 'no_such_state'\]: \['no_such_state'\] "
+        r"are not states of the plant",
     ) as info:
         _brought(path)
     message = str(info.value)
