@@ -358,3 +358,25 @@ def test_random_growing_motions_are_divergence(seed):
     v = classify(t, np.exp(growth / window * t) * x)
     assert v.kind == "divergence", v.reason
     assert not v.sustained
+
+
+@pytest.mark.slow
+def test_a_sustained_verdict_above_the_closed_spring_flutter_speed_is_not_confident():
+    """The damped Conner section at 24 m/s, 0.16 m/s above its gap-closed flutter speed
+    (23.84 m/s): a 30 s march looks stationary (its growth, about 0.17 1/s, is hidden by the
+    window) but a 150 s march diverges (measured when this was written). Above that speed a
+    large enough motion grows without bound, so a sustained verdict there is low confidence and
+    says to march longer."""
+    from aeroservo.studies.kinds import run_scenario
+
+    sc = load_scenario(ROOT / "scenarios" / "conner_freeplay_lco_damped.toml")
+    opts = replace(
+        sc.lco, speeds=(24.0,), amplitudes=(max(sc.lco.amplitudes),), continuation=False,
+        describing=False,
+    )  # fmt: skip
+    (row,) = run_scenario(replace(sc, options=opts)).lco.rows
+    if row["kind"] in SUSTAINED:
+        assert row["confidence"] == "low", row
+        assert "may still grow beyond the march (march longer)" in row["reason"]
+    else:
+        assert row["kind"] in ("divergence", "growing"), row

@@ -24,7 +24,7 @@ from ...design.user_code import LawError
 from ...errors import InputError, check_number
 from ...simulate.hinges.march import march_hinges
 from ...simulate.hinges.smooth_laws import DivergedMarch
-from ...simulate.lco_detect import classify
+from ...simulate.lco_detect import SUSTAINED, classify
 from ...system.hinge_elements import NonlinearHinge, hinge_elements
 
 __all__ = [
@@ -283,6 +283,14 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
             what = f"grows, largest rotation {reach / gap:.3g} x gap: march longer to see where"
             what += " it settles"
         reason = what + "; " + reason
+    confidence = verdict.confidence
+    if unbounded and kind_ in SUSTAINED:  # a bounded motion where large ones grow: maybe slow
+        confidence = "low"
+        reason = (
+            f"at or above the flutter speed with every spring closed ({vf:.4g} m/s), where a "
+            "large enough motion grows without bound: this one may still grow beyond the "
+            f"march (march longer); {reason}"
+        )
     rest = float(verdict.mean[ref]) - _centre(setup)
     if kind_ == "decay" and gap and abs(rest) >= EDGE * 0.5 * gap:
         side = "upper" if rest > 0 else "lower"
@@ -295,7 +303,7 @@ def _row(setup, sweep, kind, speed, amp, res) -> dict:
         "speed": float(speed),
         "initial": float(amp),
         "kind": kind_,
-        "confidence": verdict.confidence,
+        "confidence": confidence,
         "reason": reason,
         "frequency": float(verdict.frequency),
         "modulation": float(verdict.modulation),
