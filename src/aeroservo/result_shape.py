@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import math
+from abc import ABC, abstractmethod
 from collections.abc import Callable
 from pathlib import Path
 from typing import ClassVar
@@ -82,7 +83,7 @@ def json_text(obj: object, indent: int | None = 2) -> str:
     return json.dumps(finite(obj), indent=indent, default=_plain, allow_nan=False)
 
 
-class Result:
+class Result(ABC):
     """The shape every result shares (see the module docstring).
 
     A subclass defines ``summary()``, ``table``, ``to_dict()`` (its JSON-ready record) and
@@ -92,13 +93,13 @@ class Result:
     FIGURES: ClassVar[dict[str, str]] = {}
     """Figure kind -> the name of the method that draws it; the first is the main figure."""
 
+    @abstractmethod
     def summary(self) -> str:
         """A readable summary, a few lines of text."""
-        raise NotImplementedError
 
+    @abstractmethod
     def to_dict(self) -> dict:
         """The result as JSON-ready data (SI units)."""
-        raise NotImplementedError
 
     @property
     def figure_kinds(self) -> tuple[str, ...]:
