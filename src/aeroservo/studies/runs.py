@@ -16,7 +16,6 @@ import warnings
 import numpy as np
 
 from .._threads import blas_limited
-from ..errors import NumericalError, check_derived_speed
 from .kinds import Run, check_kind, run_scenario
 from .loop_analysis import analyse_loop
 from .scenario import Scenario
@@ -91,19 +90,7 @@ def run_simulation(scenario: Scenario, progress: bool = False) -> Run:
     model = scenario.model()
     fr = flutter_boundary(model, scenario.density)
     vf = fr.flutter_speed
-    if scenario.speed is not None:
-        speed = scenario.speed
-    elif vf is None:
-        raise NumericalError(
-            f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, but the "
-            f"wing has no flutter below {fr.v_max:.4g} m/s"
-        )
-    else:
-        speed = check_derived_speed(
-            f"{scenario.source}: flight.speed_factor", scenario.speed_factor,
-            scenario.speed_factor * vf,
-            f"{scenario.speed_factor:g} x the open-loop flutter speed {vf:.6g} m/s",
-        )  # fmt: skip
+    speed = scenario.design_speed(vf, fr.v_max)
     loop = scenario.loop(model)
     spec = scenario.controller
     from ..design.interface import controller_at

@@ -137,6 +137,29 @@ class Scenario:
             aero="strip" if self.aero is None else self.aero,
         )
 
+    def design_speed(self, flutter_speed: float | None, searched_to: float | None = None) -> float:
+        """The controller's design speed [m/s]: ``flight.speed``, or ``flight.speed_factor`` x
+        the open-loop flutter speed (refused beyond the airspeed range with the key); a
+        NumericalError when that speed is needed and the wing has no flutter (below
+        ``searched_to`` [m/s], or in the searched range)."""
+        from ..errors import NumericalError, check_derived_speed
+
+        if self.speed is not None:
+            return self.speed
+        if flutter_speed is None:
+            where = (
+                "in the searched range" if searched_to is None else f"below {searched_to:.4g} m/s"
+            )
+            raise NumericalError(
+                f"{self.source}: flight.speed_factor needs the open-loop flutter speed, but the "
+                f"wing has no flutter {where}"
+            )
+        return check_derived_speed(
+            f"{self.source}: flight.speed_factor", self.speed_factor,
+            self.speed_factor * flutter_speed,
+            f"{self.speed_factor:g} x the open-loop flutter speed {flutter_speed:.6g} m/s",
+        )  # fmt: skip
+
     def engaged_range(self, flutter_speed: float | None, speed: float):
         """The speeds where the loop is engaged (:class:`~aeroservo.design.EngagedRange`):
         ``controller.engaged_speeds`` [m/s], ``controller.engaged_speed_factors`` (x the

@@ -10,9 +10,8 @@ at its root (no rigid-body modes, no 1 g load).
 
 from __future__ import annotations
 
-import math
-
 from ...errors import InputError
+from ...result_shape import finite
 from ..kinds import Run, check_kind
 from ..scenario import Scenario
 from .plots import CORRELATED, FIGURES, gust_figures
@@ -116,12 +115,6 @@ def run_gust_scenario(
     return Run(scenario, gust_summary(result, scenario), loads=result, title=scenario.name)
 
 
-def _plain(v: object) -> object:
-    """A JSON value of a table cell: numpy scalars as Python numbers, NaN as None."""
-    v = v.item() if hasattr(v, "item") else v
-    return None if isinstance(v, float) and not math.isfinite(v) else v
-
-
 def gust_summary(result, scenario: Scenario | None = None) -> dict:
     """The JSON-ready summary of a gust-loads result: the worst limit load of each load per
     loop (incremental, clamped wing), the loads the loop raises, the notes, the actuator
@@ -131,14 +124,14 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
         rows = result.worst(loop)
         worst[loop] = {
             load: {
-                "limit": _plain(row["limit"]),
+                "limit": finite(row["limit"]),
                 "unit": row["unit"],
                 "source": row["source"],
                 "point": int(row["point"]),
                 "flight_point": _label(result.record(int(row["point"]), loop)),
-                "discrete_max": _plain(row["discrete_max"]),
-                "discrete_min": _plain(row["discrete_min"]),
-                "turbulence": _plain(row["turbulence"]),
+                "discrete_max": finite(row["discrete_max"]),
+                "discrete_min": finite(row["discrete_min"]),
+                "turbulence": finite(row["turbulence"]),
             }
             for load, row in rows.iterrows()
         }
@@ -182,6 +175,6 @@ def gust_summary(result, scenario: Scenario | None = None) -> dict:
     if result.loops == ["open", "closed"]:
         a = result.alleviation
         summary["alleviation_pct"] = [
-            {k: _plain(v) for k, v in row.items()} for row in a.to_dict(orient="records")
+            {k: finite(v) for k, v in row.items()} for row in a.to_dict(orient="records")
         ]
     return summary

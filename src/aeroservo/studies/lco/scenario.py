@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ...errors import NumericalError, check_derived_speed
+from ...result_shape import finite
 from ..kinds import Run, check_kind
 from ..scenario import Scenario
 
@@ -51,18 +51,7 @@ def lco_setup(scenario: Scenario):
     if spec is not None:
         from ...design.interface import controller_at
 
-        speed = scenario.speed
-        if speed is None:
-            if vf is None:
-                raise NumericalError(
-                    f"{scenario.source}: flight.speed_factor needs the open-loop flutter speed, "
-                    "but the wing has no flutter in the searched range"
-                )
-            speed = check_derived_speed(
-                f"{scenario.source}: flight.speed_factor", scenario.speed_factor,
-                scenario.speed_factor * vf,
-                f"{scenario.speed_factor:g} x the open-loop flutter speed {vf:.6g} m/s",
-            )  # fmt: skip
+        speed = scenario.design_speed(vf)
         loop = scenario.loop(model)
         ctrl = controller_at(loop.design_controller(spec, speed, scenario.sample_rate, vf), speed)
         limits = spec.limits
@@ -186,12 +175,6 @@ def _coarse_step(result) -> str:
     )
 
 
-def _plain(v: object) -> object:
-    """A JSON value: numpy scalars as Python numbers, NaN as None."""
-    v = v.item() if hasattr(v, "item") else v
-    return None if isinstance(v, float) and not math.isfinite(v) else v
-
-
 def lco_summary(result, scenario: Scenario | None = None) -> dict:
     """The JSON-ready summary of a limit-cycle result: where sustained oscillations settle
     (``lco_onset``, ``lco_speeds`` and the ranges of the amplitudes and frequencies of the
@@ -213,8 +196,8 @@ def lco_summary(result, scenario: Scenario | None = None) -> dict:
         "gap": s.get("gap"),
         "closed_loop": s.get("closed_loop", False),
         "controller": s.get("controller", ""),
-        "open_loop_flutter_speed": _plain(s.get("open_loop_flutter_speed")),
-        "lco_onset": _plain(result.onset()),
+        "open_loop_flutter_speed": finite(s.get("open_loop_flutter_speed")),
+        "lco_onset": finite(result.onset()),
         "lco_speeds": sorted({r["speed"] for r in lcos}),
         "lco_amplitude_range": [
             min(r["amplitude"] for r in lcos),
@@ -229,7 +212,7 @@ def lco_summary(result, scenario: Scenario | None = None) -> dict:
         if lcos
         else None,
         "lco_classes": class_ranges(result),
-        "diverged_from": _plain(result.diverged_from()),
+        "diverged_from": finite(result.diverged_from()),
         "hysteresis_speeds": result.hysteresis(),
         "marches": len(result.rows),
         "verdicts": counts,
@@ -245,7 +228,7 @@ def lco_summary(result, scenario: Scenario | None = None) -> dict:
         },
     }
     if result.branches is not None:
-        summary["describing_onset"] = _plain(result.branches.onset())
+        summary["describing_onset"] = finite(result.branches.onset())
     return summary
 
 
